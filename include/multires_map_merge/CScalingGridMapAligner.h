@@ -1,0 +1,112 @@
+#pragma once
+// The aligner facade: two occupancy grids in, the similarity between them
+// out, in the order of the method:
+//   1. grids → class images; SIFT over a resolution pyramid; 2-point RANSAC
+//      → similarity hypotheses (FeatureHypotheses.h)
+//   2. edge points of both maps (EdgePoints.h)
+//   3. each hypothesis refined by trimmed scaling ICP (TsICP.h)
+//   4. the best refinement judged against both maps' cells (MapAgreement.h);
+//      below min_confidence it is reported as not merged.
+// Resolution metadata is not needed: everything runs in cell coordinates and
+// the scale between the maps' cells is estimated.
+
+#include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/Similarity2D.h>
+#include <multires_map_merge/TsICP.h>
+
+#include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/slam/CMetricMapsAlignmentAlgorithm.h>
+
+#include <map>
+#include <string>
+
+namespace multires_map_merge
+{
+class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
+{
+   public:
+	CScalingGridMapAligner();
+
+	struct TConfigParams : public mrpt::config::CLoadableOptions
+	{
+		// --- Features and RANSAC (initial hypotheses)
+		int pyramid_levels = 4;  //!< per map; each level halves the cell count per axis
+		double sift_contrast_threshold = 0.04;
+		double sift_edge_threshold = 10;
+		double ratio_test = 0.8;
+		double ransac_threshold = 3.0;  //!< cells of the reference pyramid level
+		int ransac_iterations = 4000;
+		int ransac_min_inliers = 5;
+		int hypotheses_per_level_pair = 2;
+		int max_hypotheses = 8;  //!< refined by TsICP, most inliers first
+		// --- TsICP
+		double xi_min = 0.35;
+		double lambda = 2.0;
+		int icp_max_iterations = 100;
+		double icp_relative_tolerance = 1e-7;
+		// --- Decision
+		/** Below this the result is "not merged". */
+		double min_confidence = 0.5;
+		/** Trust the stated resolutions as a prior on the scale. */
+		bool use_resolution_metadata = false;
+		double metadata_scale_tolerance = 0.15;  //!< relative, with use_resolution_metadata
+
+		void loadFromConfigFile(
+			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+		void saveToConfigFile(
+			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+
+		FeatureParams featureParams() const;
+		TsICPParams icpParams() const;
+	} options;
+
+	struct TReturnInfo : public mrpt::slam::TMetricMapAlignmentResult
+	{
+		bool success = false;  //!< merged with confidence ≥ min_confidence
+		std::string message;  //!< why not, when not
+		/** x_ref = metric(x_other), metres, each map read with its stated metadata. */
+		Similarity2D metric;
+		/** The same between cell coordinates; cells.scale = other cells per ref cell. */
+		Similarity2D cells;
+		/** The feature (RANSAC) estimate TsICP started from, cell coordinates. */
+		Similarity2D initial_cells;
+		/** Other's real cell size implied by the reference's stated one. */
+		double implied_resolution_other = 0;
+		double overlap = 0;  //!< TsICP's ξ
+		double objective = 0;  //!< TsICP's ψ, squared reference cells
+		double trimmed_rmse_coarse_cells = 0;  //!< √e(ξ) in cells of the coarser map
+		double consistency = 0;  //!< MapAgreement
+		double confidence = 0;  //!< in [0,1]
+		int ransac_inliers = 0;
+		int ransac_matches = 0;
+		int icp_iterations = 0;
+		size_t hypotheses = 0, hypotheses_refined = 0;
+		size_t ref_edge_points = 0, other_edge_points = 0;
+		std::vector<double> objective_history;
+		std::map<std::string, double> stage_seconds;  //!< features, ransac, edges, icp, verify
+	};
+
+	/** The full similarity between two grids. Never throws on bad map
+	 * content: the reason is in TReturnInfo::message with success = false. */
+	TReturnInfo alignScaled(
+		const mrpt::maps::COccupancyGridMap2D& ref,
+		const mrpt::maps::COccupancyGridMap2D& other) const;
+
+	/** MRPT interface. m1 = reference, m2 = other, both COccupancyGridMap2D.
+	 * The initial estimate is not needed (the search is global) and ignored.
+	 * Returns the metric SE(2) pose of m2's frame in m1's frame (the scale is
+	 * in the TReturnInfo, if one is passed), or nullptr when not merged. */
+	mrpt::poses::CPosePDF::Ptr AlignPDF(
+		const mrpt::maps::CMetricMap* m1, const mrpt::maps::CMetricMap* m2,
+		const mrpt::poses::CPosePDFGaussian& initialEstimationPDF,
+		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
+
+	/** Not supported: grid maps are 2-D. Throws. */
+	mrpt::poses::CPose3DPDF::Ptr Align3DPDF(
+		const mrpt::maps::CMetricMap* m1, const mrpt::maps::CMetricMap* m2,
+		const mrpt::poses::CPose3DPDFGaussian& initialEstimationPDF,
+		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
+};
+
+}  // namespace multires_map_merge

@@ -1,0 +1,16 @@
+#pragma once
+// Edge points: occupied cells that border free space, the structure both maps
+// share whatever their resolution. TsICP registers these.
+
+#include <multires_map_merge/TsICP.h>
+
+#include <opencv2/core.hpp>
+
+namespace multires_map_merge
+{
+/** Cell coordinates (x = column, y = row; cell centre at integer coordinates)
+ * of the occupied cells of a class image (see GridImage.h) with a free cell
+ * among their 8 neighbours. */
+PointList edgePoints(const cv::Mat& classes);
+
+}  // namespace multires_map_merge

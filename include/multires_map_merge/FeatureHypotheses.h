@@ -1,0 +1,73 @@
+#pragma once
+// Initial similarity hypotheses from image features (method step 1).
+//
+// SIFT is scale-invariant in principle, but a 2 cm map and a 10 cm map of the
+// same wall do not look alike at any one scale: the fine map shows dotted,
+// several-cell-thick structure the coarse one never recorded. So both maps are
+// resampled into a pyramid the way a coarser grid would have recorded them
+// (resampleClasses), and every level of one is matched against every level of
+// the other. The level pair whose cell sizes agree yields matches; each level
+// pair gives its own 2-point RANSAC hypotheses, all mapped back to full
+// resolution cell coordinates.
+
+#include <multires_map_merge/Similarity2D.h>
+
+#include <opencv2/core.hpp>
+#include <optional>
+#include <vector>
+
+namespace multires_map_merge
+{
+struct FeatureParams
+{
+	int pyramid_levels = 4;  //!< levels per map, each half the previous size
+	int min_level_size = 64;  //!< cells; smaller levels are skipped
+	double sift_contrast_threshold = 0.04;
+	double sift_edge_threshold = 10;
+	double ratio_test = 0.8;  //!< Lowe's ratio for accepting a match
+	double ransac_threshold = 3.0;  //!< reprojection error, cells of the reference level
+	int ransac_iterations = 4000;
+	double ransac_confidence = 0.999;
+	int min_inliers = 5;
+	int hypotheses_per_level_pair = 2;  //!< RANSAC re-runs on the matches left
+	/** Draw unexplored space like free space for SIFT. Off by default: in a
+	 * fine map the walls are dotted and the known/unknown boundary carries the
+	 * structure, so erasing it loses the 2 cm vs 10 cm matches. */
+	bool unknown_as_free = false;
+};
+
+struct Hypothesis
+{
+	Similarity2D other_to_ref;  //!< cell coordinates, full resolution
+	int inliers = 0;
+	int matches = 0;
+	int ref_level = 0, other_level = 0;
+};
+
+/** Keypoints and descriptors of one pyramid level. */
+struct LevelFeatures
+{
+	double scale = 1;  //!< level cells per full-resolution cell
+	std::vector<cv::Point2f> points;  //!< full-resolution cell coordinates
+	cv::Mat descriptors;
+};
+
+/** SIFT on every pyramid level of a class image. */
+std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const FeatureParams& p);
+
+/** Similarity hypotheses other → ref, most RANSAC inliers first, near-
+ * duplicates removed. `expected_scale` (from trusted metadata) drops the
+ * hypotheses whose scale is more than `scale_tolerance` (relative) away. */
+std::vector<Hypothesis> featureHypotheses(
+	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other,
+	const FeatureParams& p, std::optional<double> expected_scale = std::nullopt,
+	double scale_tolerance = 0.15);
+
+/** RANSAC over point correspondences for a 4-DOF similarity (2-point
+ * minimal sets, cv::estimateAffinePartial2D). Returns std::nullopt if no
+ * model reaches min_inliers; `inlier_mask` marks the inliers. */
+std::optional<Similarity2D> ransacSimilarity(
+	const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to, double threshold,
+	int iterations, double confidence, int min_inliers, std::vector<uchar>& inlier_mask);
+
+}  // namespace multires_map_merge

@@ -1,0 +1,51 @@
+#pragma once
+// Grid ↔ image conversion, in one place. Everything in this package works on
+// "class images": CV_8UC1 with row = cy and column = cx of the grid (no flip),
+// so image pixel coordinates *are* cell coordinates and a similarity found
+// between two class images is a similarity between the two grids' cells.
+// Only images meant for people (PNG output) are flipped so that +y points up.
+
+#include <multires_map_merge/Similarity2D.h>
+
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <opencv2/core.hpp>
+
+namespace multires_map_merge
+{
+/** The three cell classes, as grey levels (dark = occupied, as maps are drawn). */
+enum CellClass : uint8_t
+{
+	kOccupied = 0,
+	kUnknown = 127,
+	kFree = 255
+};
+
+/** Occupancy probability bounds: a cell is occupied above kOccupiedAbove,
+ * free below kFreeBelow, unknown in between. */
+constexpr float kOccupiedAbove = 0.505f;
+constexpr float kFreeBelow = 0.495f;
+
+CellClass classify(float occupancy_probability);
+
+/** Occupancy probability of a cell (MRPT stores the probability of *free*). */
+inline float occupancyProbability(const mrpt::maps::COccupancyGridMap2D& g, int cx, int cy)
+{
+	return 1.0f - g.getCell(cx, cy);
+}
+
+/** Class image of a grid (row = cy, no flip). */
+cv::Mat toClassImage(const mrpt::maps::COccupancyGridMap2D& grid);
+
+/** Cell coordinates → metric coordinates of this grid, from its stated metadata. */
+Similarity2D cellToMetric(const mrpt::maps::COccupancyGridMap2D& grid);
+
+/** Resamples a class image by `factor` (< 1 shrinks) the way a coarser grid
+ * would have recorded the same world: a coarse cell is occupied if any fine
+ * cell under it is, else free if any is, else unknown. A thin wall stays a
+ * wall, which plain area averaging would wash out. */
+cv::Mat resampleClasses(const cv::Mat& classes, double factor);
+
+/** A class image as people expect to see a map: +y up. */
+cv::Mat forDisplay(const cv::Mat& classes);
+
+}  // namespace multires_map_merge

@@ -1,0 +1,55 @@
+#pragma once
+// Trimmed scaling ICP (TsICP): registers `other` onto `ref` with a similarity,
+// using backward correspondences (for every reference point, the nearest
+// transformed other point) and an overlap ξ chosen each iteration to minimise
+// ψ(ξ) = e(ξ) / ξ^(1+λ).
+
+#include <multires_map_merge/Similarity2D.h>
+
+#include <vector>
+
+namespace multires_map_merge
+{
+using PointList = std::vector<Eigen::Vector2d>;
+
+struct TsICPParams
+{
+	double xi_min = 0.35;  //!< smallest overlap the trimming may choose
+	double lambda = 2.0;  //!< overlap preference in ψ(ξ) = e(ξ)/ξ^(1+λ)
+	int max_iterations = 100;
+	/** Stops when ψ improves by less than this fraction of itself. */
+	double relative_tolerance = 1e-7;
+};
+
+struct TsICPResult
+{
+	Similarity2D transform;  //!< other → ref
+	double overlap = 0;  //!< the ξ of the last iteration
+	double objective = 0;  //!< ψ(ξ) of the final transform
+	double trimmed_mse = 0;  //!< e(ξ), squared ref units
+	int iterations = 0;
+	bool converged = false;  //!< false if it stopped at max_iterations
+	/** ψ before each re-fit; history[0] is the start's. Non-increasing. */
+	std::vector<double> objective_history;
+};
+
+/** Result of the trimming step on one correspondence set, exposed so that it
+ * can be tested on its own. */
+struct Trimming
+{
+	size_t count = 0;  //!< how many of the sorted pairs are kept
+	double overlap = 0;  //!< count / N
+	double mse = 0;  //!< e(ξ)
+	double objective = 0;  //!< ψ(ξ)
+};
+
+/** Picks ξ ∈ [xi_min, 1] minimising ψ over squared distances sorted ascending. */
+Trimming chooseOverlap(const std::vector<double>& sorted_sq_dist, const TsICPParams& p);
+
+/** Runs TsICP from `start`. Throws std::invalid_argument on fewer than 3
+ * points in either set or a non-finite/non-positive start. */
+TsICPResult runTsICP(
+	const PointList& ref, const PointList& other, const Similarity2D& start,
+	const TsICPParams& p = {});
+
+}  // namespace multires_map_merge

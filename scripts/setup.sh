@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages this package builds and tests against, then
+# configures and builds it. Idempotent: re-running it only rebuilds.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$here/build}
+
+pkgs=(
+  build-essential cmake pkg-config
+  ros-core-dev catkin python3-rostest python3-rosbag python3-nav-msgs python3-geometry-msgs
+  libnav-msgs-dev libgeometry-msgs-dev libstd-msgs-dev librosbag-dev ros-message-generation ros-message-runtime
+  libmrpt-dev libmrpt-ros1bridge-dev mrpt-apps mrpt-common
+  libopencv-dev libeigen3-dev libgtest-dev libtclap-dev
+)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo=sudo
+  $sudo apt-get update
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"
+fi
+
+# The pyenv python3 on PATH cannot import Debian's python3-* modules (catkin_pkg, genmsg).
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3
+cmake --build "$build" -j2

@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# README command (2): set up, build everything including the tests, run them all.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$here/build}
+"$here/scripts/setup.sh"
+cmake --build "$build" -j2 --target tests
+# ROS tools write here; keep them out of $HOME.
+export ROS_HOME="$build/ros_home" ROS_LOG_DIR="$build/ros_home/log"
+mkdir -p "$ROS_LOG_DIR"
+cd "$build"
+ctest --output-on-failure

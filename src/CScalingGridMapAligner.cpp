@@ -1,0 +1,258 @@
+#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/EdgePoints.h>
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/MapAgreement.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/system/CTicTac.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace multires_map_merge
+{
+using mrpt::maps::COccupancyGridMap2D;
+
+CScalingGridMapAligner::CScalingGridMapAligner()
+{
+	setLoggerName("CScalingGridMapAligner");
+}
+
+void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	MRPT_LOAD_CONFIG_VAR(pyramid_levels, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(sift_contrast_threshold, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(sift_edge_threshold, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(ratio_test, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(ransac_threshold, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(ransac_iterations, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(ransac_min_inliers, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(hypotheses_per_level_pair, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(max_hypotheses, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(xi_min, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(lambda, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(icp_relative_tolerance, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(min_confidence, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(use_resolution_metadata, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(metadata_scale_tolerance, double, c, s);
+}
+
+void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
+	mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	MRPT_SAVE_CONFIG_VAR_COMMENT(pyramid_levels, "Pyramid levels per map (each halves the size)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(sift_contrast_threshold, "SIFT contrast threshold");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(sift_edge_threshold, "SIFT edge threshold");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(ratio_test, "Lowe's ratio test for feature matches");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(ransac_threshold, "RANSAC inlier threshold [cells of the reference level]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(ransac_iterations, "RANSAC iterations per level pair");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(ransac_min_inliers, "Fewest RANSAC inliers for a hypothesis");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(hypotheses_per_level_pair, "RANSAC re-runs per level pair");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(min_confidence, "Below this the maps are reported as not merged");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(use_resolution_metadata, "Use the stated resolutions as a scale prior");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(metadata_scale_tolerance, "Relative scale tolerance of that prior");
+}
+
+FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
+{
+	FeatureParams p;
+	p.pyramid_levels = pyramid_levels;
+	p.sift_contrast_threshold = sift_contrast_threshold;
+	p.sift_edge_threshold = sift_edge_threshold;
+	p.ratio_test = ratio_test;
+	p.ransac_threshold = ransac_threshold;
+	p.ransac_iterations = ransac_iterations;
+	p.min_inliers = ransac_min_inliers;
+	p.hypotheses_per_level_pair = hypotheses_per_level_pair;
+	return p;
+}
+
+TsICPParams CScalingGridMapAligner::TConfigParams::icpParams() const
+{
+	TsICPParams p;
+	p.xi_min = xi_min;
+	p.lambda = lambda;
+	p.max_iterations = icp_max_iterations;
+	p.relative_tolerance = icp_relative_tolerance;
+	return p;
+}
+
+namespace
+{
+std::string checkGrid(const COccupancyGridMap2D& g, const char* which)
+{
+	std::ostringstream why;
+	const double res = g.getResolution();
+	if (!std::isfinite(res) || !(res > 0))
+		why << which << " map has an invalid resolution (" << res << ")";
+	else if (!std::isfinite(g.getXMin()) || !std::isfinite(g.getYMin()))
+		why << which << " map has a non-finite origin";
+	else if (g.getSizeX() < 8 || g.getSizeY() < 8)
+		why << which << " map is too small (" << g.getSizeX() << "x" << g.getSizeY()
+			<< " cells; at least 8x8 needed)";
+	return why.str();
+}
+
+// Confidence in [0,1] from the cell agreement, discounted when the overlap
+// TsICP settled on is pinned at ξmin (the sign of a wrong start) or when the
+// fitted edges sit far apart.
+double confidenceOf(double consistency, double overlap, double xi_min, double rmse_coarse)
+{
+	const double pinned = std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0);
+	const double tight = std::clamp(1.5 - rmse_coarse, 0.0, 1.0);
+	const double agree = std::clamp((consistency - 0.7) / 0.25, 0.0, 1.0);
+	return agree * std::min(pinned, tight);
+}
+}  // namespace
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
+	const COccupancyGridMap2D& ref, const COccupancyGridMap2D& other) const
+{
+	mrpt::system::CTicTac total, stage;
+	TReturnInfo info;
+	auto fail = [&](const std::string& why) {
+		info.success = false;
+		info.message = why;
+		info.executionTime = total.Tac();
+		MRPT_LOG_INFO_STREAM("not merged: " << why);
+		return info;
+	};
+	for (const auto& why : {checkGrid(ref, "reference"), checkGrid(other, "other")})
+		if (!why.empty()) return fail(why);
+
+	// 1. Maps as images; features over a resolution pyramid; RANSAC.
+	stage.Tic();
+	const cv::Mat ref_img = toClassImage(ref), other_img = toClassImage(other);
+	const FeatureParams fp = options.featureParams();
+	const auto ref_feats = extractPyramidFeatures(ref_img, fp);
+	const auto other_feats = extractPyramidFeatures(other_img, fp);
+	info.stage_seconds["features"] = stage.Tac();
+
+	stage.Tic();
+	std::optional<double> expected_scale;
+	if (options.use_resolution_metadata)
+		expected_scale = other.getResolution() / ref.getResolution();
+	auto hyps = featureHypotheses(
+		ref_feats, other_feats, fp, expected_scale, options.metadata_scale_tolerance);
+	info.stage_seconds["ransac"] = stage.Tac();
+	info.hypotheses = hyps.size();
+	if (hyps.empty())
+		return fail("no consistent feature matches between the maps (do they overlap?)");
+
+	// 2. Edge points.
+	stage.Tic();
+	const PointList ref_edges = edgePoints(ref_img), other_edges = edgePoints(other_img);
+	info.ref_edge_points = ref_edges.size();
+	info.other_edge_points = other_edges.size();
+	info.stage_seconds["edges"] = stage.Tac();
+	if (ref_edges.size() < 10 || other_edges.size() < 10)
+		return fail("too few occupied cells bordering free space to register the maps");
+
+	// 3. TsICP from each hypothesis; 4. judge each on the cells. The best
+	// confidence wins; ψ breaks ties between equally trusted refinements.
+	const TsICPParams ip = options.icpParams();
+	double icp_s = 0, verify_s = 0;
+	bool have = false;
+	for (const auto& h : hyps)
+	{
+		if (static_cast<int>(info.hypotheses_refined) >= options.max_hypotheses) break;
+		++info.hypotheses_refined;
+		stage.Tic();
+		const TsICPResult r = runTsICP(ref_edges, other_edges, h.other_to_ref, ip);
+		icp_s += stage.Tac();
+		if (!r.transform.isFinite() || !(r.transform.scale > 0)) continue;
+		if (expected_scale &&
+			std::abs(std::log(r.transform.scale / *expected_scale)) >
+				std::log1p(options.metadata_scale_tolerance))
+			continue;
+
+		stage.Tic();
+		const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
+		verify_s += stage.Tac();
+		const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
+		const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
+		const double conf = confidenceOf(ag.consistency, r.overlap, ip.xi_min, rmse_coarse);
+		MRPT_LOG_DEBUG_STREAM(
+			"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform
+						  << " xi " << r.overlap << " psi " << r.objective << " rmse "
+						  << rmse_coarse << " consistency " << ag.consistency << " conf " << conf);
+		if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
+			continue;
+		have = true;
+		info.cells = r.transform;
+		info.initial_cells = h.other_to_ref;
+		info.overlap = r.overlap;
+		info.objective = r.objective;
+		info.trimmed_rmse_coarse_cells = rmse_coarse;
+		info.consistency = ag.consistency;
+		info.confidence = conf;
+		info.ransac_inliers = h.inliers;
+		info.ransac_matches = h.matches;
+		info.icp_iterations = r.iterations;
+		info.objective_history = r.objective_history;
+		if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
+	}
+	info.stage_seconds["icp"] = icp_s;
+	info.stage_seconds["verify"] = verify_s;
+	if (!have) return fail("no hypothesis survived refinement");
+
+	info.metric = cellToMetric(ref).compose(info.cells).compose(cellToMetric(other).inverse());
+	info.implied_resolution_other = info.cells.scale * ref.getResolution();
+	info.executionTime = total.Tac();
+	if (info.confidence < options.min_confidence)
+	{
+		std::ostringstream why;
+		why << "alignment not confident enough (confidence " << info.confidence << " < "
+			<< options.min_confidence << "; cell consistency " << info.consistency << ", overlap "
+			<< info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
+		auto out = fail(why.str());
+		return out;
+	}
+	info.success = true;
+	info.message = "merged";
+	return info;
+}
+
+mrpt::poses::CPosePDF::Ptr CScalingGridMapAligner::AlignPDF(
+	const mrpt::maps::CMetricMap* m1, const mrpt::maps::CMetricMap* m2,
+	const mrpt::poses::CPosePDFGaussian&,
+	mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo)
+{
+	const auto* ref = dynamic_cast<const COccupancyGridMap2D*>(m1);
+	const auto* other = dynamic_cast<const COccupancyGridMap2D*>(m2);
+	ASSERTMSG_(ref && other, "CScalingGridMapAligner aligns two COccupancyGridMap2D");
+	const TReturnInfo info = alignScaled(*ref, *other);
+	if (outInfo)
+	{
+		if (auto* full = dynamic_cast<TReturnInfo*>(&outInfo->get()))
+			*full = info;
+		else
+			outInfo->get().executionTime = info.executionTime;
+	}
+	if (!info.success) return nullptr;
+	const double sigma_xy = info.trimmed_rmse_coarse_cells *
+		std::max(ref->getResolution(), other->getResolution());
+	mrpt::math::CMatrixDouble33 cov;
+	cov.setZero();
+	cov(0, 0) = cov(1, 1) = sigma_xy * sigma_xy;
+	cov(2, 2) = mrpt::square(0.1 * M_PI / 180.0);
+	return std::make_shared<mrpt::poses::CPosePDFGaussian>(
+		mrpt::poses::CPose2D(info.metric.t.x(), info.metric.t.y(), info.metric.yaw), cov);
+}
+
+mrpt::poses::CPose3DPDF::Ptr CScalingGridMapAligner::Align3DPDF(
+	const mrpt::maps::CMetricMap*, const mrpt::maps::CMetricMap*,
+	const mrpt::poses::CPose3DPDFGaussian&, mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult>)
+{
+	THROW_EXCEPTION("CScalingGridMapAligner aligns 2-D grid maps only; use AlignPDF()");
+}
+
+}  // namespace multires_map_merge

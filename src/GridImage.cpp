@@ -1,0 +1,56 @@
+#include <multires_map_merge/GridImage.h>
+
+#include <opencv2/imgproc.hpp>
+
+namespace multires_map_merge
+{
+CellClass classify(float p)
+{
+	if (p > kOccupiedAbove) return kOccupied;
+	if (p < kFreeBelow) return kFree;
+	return kUnknown;
+}
+
+cv::Mat toClassImage(const mrpt::maps::COccupancyGridMap2D& grid)
+{
+	const int w = static_cast<int>(grid.getSizeX()), h = static_cast<int>(grid.getSizeY());
+	cv::Mat img(h, w, CV_8UC1);
+	for (int cy = 0; cy < h; ++cy)
+	{
+		auto* row = img.ptr<uint8_t>(cy);
+		for (int cx = 0; cx < w; ++cx) row[cx] = classify(occupancyProbability(grid, cx, cy));
+	}
+	return img;
+}
+
+Similarity2D cellToMetric(const mrpt::maps::COccupancyGridMap2D& grid)
+{
+	return Similarity2D::cellToMetric(grid.getResolution(), grid.getXMin(), grid.getYMin());
+}
+
+cv::Mat resampleClasses(const cv::Mat& classes, double factor)
+{
+	CV_Assert(classes.type() == CV_8UC1 && factor > 0);
+	const cv::Size size(
+		std::max(1, cvRound(classes.cols * factor)), std::max(1, cvRound(classes.rows * factor)));
+	// INTER_AREA gives each output cell the fraction of input cells of a class
+	// under it; "any" is that fraction being non-zero.
+	auto anyOf = [&](uint8_t cls) {
+		cv::Mat frac;
+		cv::resize(classes == cls, frac, size, 0, 0, factor < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
+		return frac > 0;
+	};
+	cv::Mat out(size, CV_8UC1, cv::Scalar(kUnknown));
+	out.setTo(kFree, anyOf(kFree));
+	out.setTo(kOccupied, anyOf(kOccupied));
+	return out;
+}
+
+cv::Mat forDisplay(const cv::Mat& classes)
+{
+	cv::Mat flipped;
+	cv::flip(classes, flipped, 0);
+	return flipped;
+}
+
+}  // namespace multires_map_merge

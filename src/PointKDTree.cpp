@@ -1,0 +1,48 @@
+#include <multires_map_merge/PointKDTree.h>
+
+#include <nanoflann.hpp>
+
+namespace multires_map_merge
+{
+namespace
+{
+struct PointListAdaptor
+{
+	const PointList& pts;
+	size_t kdtree_get_point_count() const { return pts.size(); }
+	double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][dim]; }
+	template <class BBox>
+	bool kdtree_get_bbox(BBox&) const
+	{
+		return false;
+	}
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<
+	nanoflann::L2_Simple_Adaptor<double, PointListAdaptor>, PointListAdaptor, 2, uint32_t>;
+}  // namespace
+
+struct PointKDTree::Impl
+{
+	explicit Impl(const PointList& p)
+		: adaptor{p}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16))
+	{
+		tree.buildIndex();
+	}
+	PointListAdaptor adaptor;
+	Tree tree;
+};
+
+PointKDTree::PointKDTree(const PointList& points) : impl_(std::make_unique<Impl>(points))
+{
+}
+PointKDTree::~PointKDTree() = default;
+
+std::pair<size_t, double> PointKDTree::nearest(const Eigen::Vector2d& q) const
+{
+	uint32_t idx = 0;  // nanoflann 1.4 indexes with uint32_t
+	double d2 = 0;
+	impl_->tree.knnSearch(q.data(), 1, &idx, &d2);
+	return {static_cast<size_t>(idx), d2};
+}
+
+}  // namespace multires_map_merge

@@ -1,0 +1,126 @@
+#include <multires_map_merge/PointKDTree.h>
+#include <multires_map_merge/TsICP.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+namespace multires_map_merge
+{
+Trimming chooseOverlap(const std::vector<double>& sorted_sq_dist, const TsICPParams& p)
+{
+	const size_t n_all = sorted_sq_dist.size();
+	Trimming best;
+	if (n_all == 0) return best;
+	const size_t n_min = std::max<size_t>(
+		1, static_cast<size_t>(std::ceil(p.xi_min * static_cast<double>(n_all))));
+	best.objective = std::numeric_limits<double>::infinity();
+	double sum = 0;
+	for (size_t n = 1; n <= n_all; ++n)
+	{
+		sum += sorted_sq_dist[n - 1];
+		if (n < n_min) continue;
+		const double xi = static_cast<double>(n) / static_cast<double>(n_all);
+		const double e = sum / static_cast<double>(n);
+		const double psi = e / std::pow(xi, 1.0 + p.lambda);
+		if (psi < best.objective) best = {n, xi, e, psi};
+	}
+	return best;
+}
+
+namespace
+{
+struct Pair
+{
+	double sq_dist;  //!< in ref units
+	size_t ref_idx, other_idx;
+};
+
+// Backward correspondences: every reference point with its nearest
+// transformed other point. Similarities preserve the order of distances, so
+// the query runs in the other map's frame on a tree built once, and the
+// distance is scaled back to ref units.
+std::vector<Pair> backwardPairs(
+	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref)
+{
+	const Similarity2D ref_to_other = other_to_ref.inverse();
+	const double s2 = other_to_ref.scale * other_to_ref.scale;
+	std::vector<Pair> pairs(ref.size());
+#pragma omp parallel for schedule(static)
+	for (size_t j = 0; j < ref.size(); ++j)
+	{
+		const auto [i, d2] = other_tree.nearest(ref_to_other(ref[j]));
+		pairs[j] = {s2 * d2, j, i};
+	}
+	std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+		return a.sq_dist < b.sq_dist;
+	});
+	return pairs;
+}
+
+Trimming trim(const std::vector<Pair>& pairs, const TsICPParams& p)
+{
+	std::vector<double> d(pairs.size());
+	std::transform(pairs.begin(), pairs.end(), d.begin(), [](const Pair& q) {
+		return q.sq_dist;
+	});
+	return chooseOverlap(d, p);
+}
+
+Similarity2D fitSimilarity(
+	const PointList& ref, const PointList& other, const std::vector<Pair>& pairs, size_t n)
+{
+	Eigen::Matrix2Xd src(2, n), dst(2, n);
+	for (size_t k = 0; k < n; ++k)
+	{
+		src.col(k) = other[pairs[k].other_idx];
+		dst.col(k) = ref[pairs[k].ref_idx];
+	}
+	return Similarity2D::fromMatrix(Eigen::Matrix3d(Eigen::umeyama(src, dst, true)));
+}
+}  // namespace
+
+TsICPResult runTsICP(
+	const PointList& ref, const PointList& other, const Similarity2D& start,
+	const TsICPParams& p)
+{
+	if (ref.size() < 3 || other.size() < 3)
+		throw std::invalid_argument("TsICP needs at least 3 points in each set");
+	if (!start.isFinite() || !(start.scale > 0))
+		throw std::invalid_argument("TsICP start transform must be finite with scale > 0");
+	if (!(p.xi_min > 0 && p.xi_min <= 1))
+		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
+
+	const PointKDTree other_tree(other);
+	TsICPResult r;
+	r.transform = start;
+	auto pairs = backwardPairs(ref, other_tree, r.transform);
+	Trimming t = trim(pairs, p);
+	r.objective_history.push_back(t.objective);
+
+	for (r.iterations = 1; r.iterations <= p.max_iterations; ++r.iterations)
+	{
+		const Similarity2D candidate = fitSimilarity(ref, other, pairs, t.count);
+		auto candidate_pairs = backwardPairs(ref, other_tree, candidate);
+		const Trimming ct = trim(candidate_pairs, p);
+		// The re-fit and re-association can only lower ψ in exact arithmetic;
+		// a rise is rounding noise, and keeping the previous transform keeps
+		// the objective monotone.
+		if (!(ct.objective <= t.objective)) { r.converged = true; break; }
+		const double gain = t.objective - ct.objective;
+		r.transform = candidate;
+		pairs = std::move(candidate_pairs);
+		t = ct;
+		r.objective_history.push_back(t.objective);
+		if (gain <= p.relative_tolerance * t.objective) { r.converged = true; break; }
+	}
+	r.iterations = std::min(r.iterations, p.max_iterations);
+	r.overlap = t.overlap;
+	r.objective = t.objective;
+	r.trimmed_mse = t.mse;
+	return r;
+}
+
+}  // namespace multires_map_merge

@@ -1,0 +1,213 @@
+// CScalingGridMapAligner on real data with exact ground truth.
+#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/EdgePoints.h>
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GroundTruthPair.h>
+
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+
+#include <map>
+
+#include "test_data.h"
+
+using namespace multires_map_merge;
+
+namespace
+{
+const ScanSequence& scansOf(const std::string& path)
+{
+	static std::map<std::string, ScanSequence> cache;
+	auto it = cache.find(path);
+	if (it == cache.end()) it = cache.emplace(path, loadScans(path)).first;
+	return it->second;
+}
+
+struct Case
+{
+	const char* dataset;  // under /usr/share/mrpt/datasets
+	double ref_res, other_res, yaw_deg;
+	double split;  // ref renders [0, split), other [1 - split, 1)
+};
+
+std::ostream& operator<<(std::ostream& o, const Case& c)
+{
+	return o << c.dataset << " " << c.ref_res << "m vs " << c.other_res << "m, " << c.yaw_deg << " deg";
+}
+
+GroundTruthPair makePair(const ScanSequence& scans, const Case& c)
+{
+	PairSpec spec;
+	spec.ref_resolution = c.ref_res;
+	spec.other_resolution = c.other_res;
+	spec.other_frame = mrpt::poses::CPose2D(1.5, -2.5, c.yaw_deg * M_PI / 180);
+	spec.ref_end = c.split;
+	spec.other_begin = 1 - c.split;
+	return makeGroundTruthPair(scans, spec);
+}
+
+/** The issue's accuracy bounds: scale < 0.2 %, yaw < 0.2°, point RMSE < 0.5
+ * cell of the coarser map (over the other map's edge points). */
+void expectAccurate(const GroundTruthPair& pair, const CScalingGridMapAligner::TReturnInfo& r)
+{
+	ASSERT_TRUE(r.success) << r.message;
+	const Similarity2D truth_cells = pair.otherCellsToRefCells();
+	EXPECT_NEAR(r.cells.scale / truth_cells.scale, 1.0, 0.002);
+	EXPECT_NEAR(wrapToPi(r.cells.yaw - truth_cells.yaw) * 180 / M_PI, 0.0, 0.2);
+	EXPECT_NEAR(r.metric.scale, 1.0, 0.002);  // metadata is true here
+	PointList pts = edgePoints(toClassImage(pair.other));
+	for (auto& p : pts) p = cellToMetric(pair.other)(p);
+	const double coarse = std::max(pair.ref.getResolution(), pair.other.getResolution());
+	EXPECT_LT(pointRmse(r.metric, pair.other_to_ref, pts) / coarse, 0.5);
+	EXPECT_NEAR(r.implied_resolution_other / pair.other.getResolution(), 1.0, 0.002);
+	EXPECT_GE(r.confidence, 0.5);
+	EXPECT_GE(r.overlap, 0.35);
+}
+
+class RealPairs : public ::testing::TestWithParam<Case>
+{
+};
+
+TEST_P(RealPairs, AlignsWithinTheBounds)
+{
+	const Case c = GetParam();
+	const auto pair = makePair(scansOf(test::mrptDataset(c.dataset)), c);
+	CScalingGridMapAligner aligner;
+	expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
+}
+
+const char* kMalaga = "malaga-cs-fac-building.simplemap.gz";
+const char* kLocalization = "localization_demo.simplemap.gz";
+
+INSTANTIATE_TEST_SUITE_P(
+	Malaga, RealPairs,
+	::testing::Values(
+		Case{kMalaga, 0.05, 0.05, 0, 0.6}, Case{kMalaga, 0.05, 0.08, 30, 0.6},
+		Case{kMalaga, 0.05, 0.10, 90, 0.6}, Case{kMalaga, 0.10, 0.02, 180, 0.6},
+		Case{kMalaga, 0.02, 0.10, 270, 0.6}, Case{kMalaga, 0.03, 0.07, -123, 0.6}));
+
+// The localization_demo halves overlap less; 70 % parts keep the true
+// overlap above ξmin = 0.35, which TsICP needs.
+INSTANTIATE_TEST_SUITE_P(
+	LocalizationDemo, RealPairs,
+	::testing::Values(
+		Case{kLocalization, 0.05, 0.05, 270, 0.7}, Case{kLocalization, 0.05, 0.08, 90, 0.7},
+		Case{kLocalization, 0.10, 0.02, 180, 0.7}, Case{kLocalization, 0.02, 0.10, 45, 0.7}));
+
+TEST(Fr079, TheGroundTruthPairsOfThePaperAlign)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const ScanSequence& scans = scansOf(log);
+	ASSERT_GT(scans.size(), 4000u);
+	CScalingGridMapAligner aligner;
+	for (const Case c : {Case{"fr079", 0.02, 0.10, 90, 0.6}, Case{"fr079", 0.10, 0.02, 180, 0.6},
+						 Case{"fr079", 0.04, 0.06, 33, 0.6}})
+	{
+		SCOPED_TRACE(::testing::PrintToString(c));
+		const auto pair = makePair(scans, c);
+		expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
+	}
+}
+
+TEST(MetadataFree, WrongStatedResolutionIsRecovered)
+{
+	// The other map is really 8 cm but claims 5 cm: the implied resolution
+	// must say 8 cm, and the metric scale must absorb the lie.
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 60, 0.6});
+	const auto liar = withStatedResolution(pair.other, 0.05);
+	CScalingGridMapAligner aligner;
+	const auto r = aligner.alignScaled(pair.ref, liar);
+	ASSERT_TRUE(r.success) << r.message;
+	EXPECT_NEAR(r.implied_resolution_other, 0.08, 0.08 * 0.002);
+	EXPECT_NEAR(r.metric.scale, 0.08 / 0.05, 1.6 * 0.002);
+}
+
+TEST(MetadataPrior, UsedWhenTrustedAndRejectsContradictingScales)
+{
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.10, 200, 0.6});
+	CScalingGridMapAligner aligner;
+	aligner.options.use_resolution_metadata = true;
+	expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
+	// A prior that lies by 2x leaves no hypothesis it allows.
+	const auto r = aligner.alignScaled(pair.ref, withStatedResolution(pair.other, 0.05));
+	EXPECT_FALSE(r.success);
+	EXPECT_FALSE(r.message.empty());
+}
+
+TEST(Decision, MapsOfDifferentBuildingsAreNotMerged)
+{
+	const auto malaga = renderGrid(scansOf(test::mrptDataset(kMalaga)), 0, 99, 0.05);
+	const auto& loc_scans = scansOf(test::mrptDataset(kLocalization));
+	const auto loc = renderGrid(loc_scans, 0, loc_scans.size(), 0.08);
+	CScalingGridMapAligner aligner;
+	for (const auto& [a, b] : {std::pair{&malaga, &loc}, std::pair{&loc, &malaga}})
+	{
+		const auto r = aligner.alignScaled(*a, *b);
+		EXPECT_FALSE(r.success) << "confidence " << r.confidence << " consistency " << r.consistency;
+		EXPECT_FALSE(r.message.empty());
+	}
+}
+
+TEST(Decision, BadMapsGiveAReasonNotACrash)
+{
+	const auto good = renderGrid(scansOf(test::mrptDataset(kMalaga)), 0, 40, 0.05);
+	CScalingGridMapAligner aligner;
+	const mrpt::maps::COccupancyGridMap2D tiny(0, 0.2f, 0, 0.2f, 0.1f);
+	const mrpt::maps::COccupancyGridMap2D unknown(-10, 10, -10, 10, 0.05f);  // all unknown
+	auto r = aligner.alignScaled(good, tiny);
+	EXPECT_FALSE(r.success);
+	EXPECT_NE(r.message.find("too small"), std::string::npos) << r.message;
+	r = aligner.alignScaled(unknown, good);
+	EXPECT_FALSE(r.success);
+	EXPECT_FALSE(r.message.empty());
+}
+
+TEST(MrptInterface, AlignPDFGivesTheMetricPoseOfTheOtherFrame)
+{
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 75, 0.6});
+	CScalingGridMapAligner aligner;
+	CScalingGridMapAligner::TReturnInfo info;
+	const auto pdf = aligner.Align(&pair.ref, &pair.other, mrpt::poses::CPose2D(), info);
+	ASSERT_TRUE(pdf);
+	const auto mean = pdf->getMeanVal();
+	EXPECT_NEAR(mean.x(), 1.5, 0.04);
+	EXPECT_NEAR(mean.y(), -2.5, 0.04);
+	EXPECT_NEAR(wrapToPi(mean.phi() - 75 * M_PI / 180), 0, 0.2 * M_PI / 180);
+	EXPECT_TRUE(info.success);
+	EXPECT_GT(info.executionTime, 0);
+	// Not a grid: a clear exception rather than a crash.
+	mrpt::poses::CPose2D notAMap;
+	EXPECT_THROW(aligner.Align(&pair.ref, nullptr, notAMap), std::exception);
+}
+
+TEST(Config, IniRoundTripAndOverride)
+{
+	CScalingGridMapAligner::TConfigParams a;
+	a.xi_min = 0.4;
+	a.lambda = 1.5;
+	a.use_resolution_metadata = true;
+	a.pyramid_levels = 3;
+	// Through a real ini file, as users keep them (MRPT writes "key = value // comment").
+	const std::string path = ::testing::TempDir() + "/aligner_roundtrip.ini";
+	{
+		mrpt::config::CConfigFile out(path);
+		a.saveToConfigFile(out, "aligner");
+	}
+	CScalingGridMapAligner::TConfigParams b;
+	b.loadFromConfigFile(mrpt::config::CConfigFile(path), "aligner");
+	EXPECT_DOUBLE_EQ(b.xi_min, 0.4);
+	EXPECT_DOUBLE_EQ(b.lambda, 1.5);
+	EXPECT_TRUE(b.use_resolution_metadata);
+	EXPECT_EQ(b.pyramid_levels, 3);
+	EXPECT_DOUBLE_EQ(b.ransac_threshold, a.ransac_threshold);
+	// Keys absent from the file keep their defaults.
+	mrpt::config::CConfigFileMemory partial;
+	partial.write("aligner", "min_confidence", 0.8);
+	CScalingGridMapAligner::TConfigParams c;
+	c.loadFromConfigFile(partial, "aligner");
+	EXPECT_DOUBLE_EQ(c.min_confidence, 0.8);
+	EXPECT_DOUBLE_EQ(c.xi_min, 0.35);
+}
+}  // namespace
