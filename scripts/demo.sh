@@ -1,8 +1,17 @@
 #!/usr/bin/env bash
-# README command (1): set up, build, and align two maps rendered at different
-# resolutions from Debian's real malaga dataset.
+# README command (1): set up and build, render two real maps at 5 and 8 cm
+# from Debian's malaga dataset (the second rotated), merge them with
+# gridmap-merge without their metadata, and print the result beside the truth.
+# Usage: bash scripts/demo.sh [OUTPUT_DIR]   (default: ./demo_output)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
-"$here/scripts/setup.sh" >"${TMPDIR:-/tmp}/multires_map_merge_setup.log" 2>&1 ||
-  { tail -n 40 "${TMPDIR:-/tmp}/multires_map_merge_setup.log"; exit 1; }
-exec "${BUILD_DIR:-$here/build}/devel/lib/multires_map_merge/multires_demo" "$@"
+bin="${BUILD_DIR:-$here/build}/devel/lib/multires_map_merge"
+out=$(realpath -m "${1:-$PWD/demo_output}")
+log="${TMPDIR:-/tmp}/multires_map_merge_setup.log"
+echo "Setting up and building (log: $log) ..."
+"$here/scripts/setup.sh" >"$log" 2>&1 || { tail -n 40 "$log"; exit 1; }
+"$bin/multires_demo" --write "$out"
+"$bin/gridmap-merge" "$out/ref.gridmap.gz" "$out/other.gridmap.gz" \
+  --out "$out/merged.gridmap.gz" --png "$out/merged.png" --json "$out/result.json"
+echo
+echo "Wrote the merged map, an overlay PNG and the JSON result into $out"

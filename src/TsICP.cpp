@@ -25,7 +25,9 @@ Trimming chooseOverlap(const std::vector<double>& sorted_sq_dist, const TsICPPar
 		const double xi = static_cast<double>(n) / static_cast<double>(n_all);
 		const double e = sum / static_cast<double>(n);
 		const double psi = e / std::pow(xi, 1.0 + p.lambda);
-		if (psi < best.objective) best = {n, xi, e, psi};
+		// On ties the larger overlap wins: identical maps (e = 0 everywhere)
+		// overlap fully, they are not "pinned at ξmin".
+		if (psi <= best.objective) best = {n, xi, e, psi};
 	}
 	return best;
 }

@@ -118,3 +118,11 @@ TEST(TsICP, RejectsDegenerateInput)
 	EXPECT_THROW(runTsICP(many, many, Similarity2D(0.0, 0, {0, 0})), std::invalid_argument);
 	EXPECT_THROW(runTsICP(many, many, Similarity2D(NAN, 0, {0, 0})), std::invalid_argument);
 }
+
+TEST(ChooseOverlap, TiesGoToTheLargerOverlap)
+{
+	// Identical maps: every distance is zero, so the overlap is all of it.
+	const Trimming t = chooseOverlap(std::vector<double>(50, 0.0), TsICPParams{});
+	EXPECT_EQ(t.count, 50u);
+	EXPECT_DOUBLE_EQ(t.objective, 0.0);
+}

@@ -1,8 +1,15 @@
 // Demo: two maps rendered from Debian's real malaga simplemap at two
 // resolutions, the second in a rotated, shifted frame, aligned without using
 // their resolution metadata. Prints the estimate next to the truth.
+//   multires_demo [SIMPLEMAP]          align 5/8 cm and 2/10 cm pairs in-process
+//   multires_demo --write DIR          write the 5/8 cm pair as DIR/ref.gridmap.gz,
+//                                      DIR/other.gridmap.gz and print the truth
+//                                      (scripts/demo.sh then runs gridmap-merge)
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/MapIO.h>
+
+#include <filesystem>
 
 #include <cstdio>
 #include <exception>
@@ -11,10 +18,29 @@ using namespace multires_map_merge;
 
 int main(int argc, char** argv)
 {
-	const std::string simplemap =
-		argc > 1 ? argv[1] : "/usr/share/mrpt/datasets/malaga-cs-fac-building.simplemap.gz";
+	const std::string malaga = "/usr/share/mrpt/datasets/malaga-cs-fac-building.simplemap.gz";
 	try
 	{
+		if (argc == 3 && std::string(argv[1]) == "--write")
+		{
+			PairSpec spec;
+			spec.ref_resolution = 0.05;
+			spec.other_resolution = 0.08;
+			spec.other_frame = mrpt::poses::CPose2D(1.5, -2.5, 30 * M_PI / 180);
+			const GroundTruthPair pair = makeGroundTruthPair(loadScans(malaga), spec);
+			std::filesystem::create_directories(argv[2]);
+			const std::string dir = argv[2];
+			saveGridMap(pair.ref, dir + "/ref.gridmap.gz");
+			saveGridMap(pair.other, dir + "/other.gridmap.gz");
+			std::printf(
+				"Rendered two overlapping parts of the real malaga run:\n"
+				"  %s/ref.gridmap.gz   at 5 cm\n  %s/other.gridmap.gz at 8 cm, its frame rotated and shifted\n"
+				"TRUTH: OTHER's frame in REF's: x 1.5 m, y -2.5 m, yaw 30 deg, scale 1; "
+				"OTHER's resolution 0.08 m (%.4f REF cells per OTHER cell)\n\n",
+				dir.c_str(), dir.c_str(), pair.otherCellsToRefCells().scale);
+			return 0;
+		}
+		const std::string simplemap = argc > 1 ? argv[1] : malaga;
 		const ScanSequence scans = loadScans(simplemap);
 		std::printf("%zu keyframes from %s\n\n", scans.size(), simplemap.c_str());
 		struct Demo

@@ -1,0 +1,37 @@
+#pragma once
+// Fusion (method step 4): one map on the union of both extents, in the
+// reference map's world frame, each output cell filled by the paper's rule:
+// occupied if either map is occupied there, else free if either is free,
+// else unknown; within a class the stronger evidence is kept.
+
+#include <multires_map_merge/Similarity2D.h>
+
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <opencv2/core.hpp>
+
+namespace multires_map_merge
+{
+struct FusedMap
+{
+	mrpt::maps::COccupancyGridMap2D merged;
+	/** Each input as sampled on the merged grid (class images, row = cy):
+	 * what the overlay PNG shows. */
+	cv::Mat ref_classes, other_classes;
+};
+
+/** Fuses `other` into `ref`'s frame. `other_to_ref` maps other's metric
+ * coordinates (its stated metadata) to ref's, as CScalingGridMapAligner's
+ * TReturnInfo::metric does. Every output cell samples both maps at sub-cell
+ * points (the other by the inverse transform), enough of them that no input
+ * cell is skipped, so a one-cell wall survives a coarser output.
+ * Throws std::invalid_argument on a non-positive or non-finite resolution,
+ * an invalid transform, or an output of more than `max_cells` cells. */
+FusedMap fuseGridMaps(
+	const mrpt::maps::COccupancyGridMap2D& ref, const mrpt::maps::COccupancyGridMap2D& other,
+	const Similarity2D& other_to_ref, double output_resolution,
+	size_t max_cells = size_t(1) << 28);
+
+/** The cell rule on two occupancy probabilities (0.5 = unknown). */
+float fuseCell(float p_ref, float p_other);
+
+}  // namespace multires_map_merge

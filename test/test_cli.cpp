@@ -1,0 +1,188 @@
+// gridmap-merge end to end on real data: every input format, outputs, JSON
+// against ground truth, exit codes.
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/MapIO.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "test_data.h"
+
+using namespace multires_map_merge;
+namespace fs = std::filesystem;
+
+namespace
+{
+struct CliRun
+{
+	int exit_code;
+	std::string output;  // stdout + stderr
+};
+
+CliRun runCli(const std::string& args)
+{
+	const std::string cmd = std::string(MMM_CLI) + " " + args + " 2>&1";
+	FILE* p = popen(cmd.c_str(), "r");
+	std::string out;
+	std::array<char, 4096> buf;
+	while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
+	const int status = p ? pclose(p) : -1;
+	return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string slurp(const std::string& path)
+{
+	std::ifstream f(path);
+	std::stringstream s;
+	s << f.rdbuf();
+	return s.str();
+}
+
+double jsonNumber(const std::string& json, const std::string& key)
+{
+	std::smatch m;
+	if (!std::regex_search(json, m, std::regex("\"" + key + "\": (-?[0-9.eE+-]+)")))
+		throw std::runtime_error("no number for " + key + " in " + json);
+	return std::stod(m[1]);
+}
+
+std::string dir()
+{
+	const std::string d = ::testing::TempDir() + "/cli";
+	fs::create_directories(d);
+	return d;
+}
+
+// A real malaga pair at 5 and 8 cm, the second rotated 150° and shifted.
+const GroundTruthPair& malagaPair()
+{
+	static const GroundTruthPair p = [] {
+		PairSpec spec;
+		spec.ref_resolution = 0.05;
+		spec.other_resolution = 0.08;
+		spec.other_frame = mrpt::poses::CPose2D(-2.0, 3.0, 150 * M_PI / 180);
+		return makeGroundTruthPair(loadScans(test::mrptDataset("malaga-cs-fac-building.simplemap.gz")), spec);
+	}();
+	return p;
+}
+
+void expectTransformMatchesTruth(const std::string& json)
+{
+	const auto& gt = malagaPair().other_to_ref;
+	EXPECT_NE(json.find("\"success\": true"), std::string::npos) << json;
+	EXPECT_NEAR(jsonNumber(json, "x"), gt.t.x(), 0.04);
+	EXPECT_NEAR(jsonNumber(json, "y"), gt.t.y(), 0.04);
+	EXPECT_NEAR(wrapToPi(jsonNumber(json, "yaw") - gt.yaw), 0, 0.2 * M_PI / 180);
+	EXPECT_NEAR(jsonNumber(json, "scale"), 1.0, 0.002);
+	EXPECT_NEAR(jsonNumber(json, "scale_cells"), 0.08 / 0.05, 1.6 * 0.002);
+	EXPECT_NEAR(jsonNumber(json, "implied_resolution_other"), 0.08, 0.08 * 0.002);
+	for (const char* k : {"overlap", "objective", "inliers", "confidence", "runtime_s"})
+		EXPECT_NO_THROW(jsonNumber(json, k)) << k;
+	EXPECT_NE(json.find("\"stages\": {"), std::string::npos);
+	EXPECT_NE(json.find("\"error\": \"\""), std::string::npos);
+}
+}  // namespace
+
+TEST(Cli, GridmapInputsAllOutputsAndJsonAgainstTruth)
+{
+	const std::string d = dir();
+	saveGridMap(malagaPair().ref, d + "/ref.gridmap.gz");
+	saveGridMap(malagaPair().other, d + "/other.gridmap.gz");
+	const CliRun r = runCli(
+		d + "/ref.gridmap.gz " + d + "/other.gridmap.gz --json " + d + "/a.json --out " + d +
+		"/merged.gridmap.gz --png " + d + "/a.png");
+	ASSERT_EQ(r.exit_code, 0) << r.output;
+	EXPECT_NE(r.output.find("implied resolution"), std::string::npos) << r.output;
+	expectTransformMatchesTruth(slurp(d + "/a.json"));
+	const auto merged = loadGridMap(d + "/merged.gridmap.gz");
+	EXPECT_NEAR(merged.getResolution(), 0.05, 1e-6);  // the reference's by default
+	// The union contains the reference map.
+	EXPECT_LE(merged.getXMin(), malagaPair().ref.getXMin() + 1e-3);
+	EXPECT_GE(merged.getYMax(), malagaPair().ref.getYMax() - 1e-3);
+	const cv::Mat png = cv::imread(d + "/a.png");
+	ASSERT_FALSE(png.empty());
+	EXPECT_EQ(png.cols, static_cast<int>(merged.getSizeX()));
+	EXPECT_EQ(png.rows, static_cast<int>(merged.getSizeY()));
+}
+
+TEST(Cli, MapServerYamlInAndOutWithFinestResolution)
+{
+	const std::string d = dir();
+	saveGridMap(malagaPair().ref, d + "/ref.yaml");
+	saveGridMap(malagaPair().other, d + "/other.yaml");
+	const CliRun r = runCli(
+		d + "/ref.yaml " + d + "/other.yaml --json " + d + "/b.json --out " + d +
+		"/merged.yaml --output-resolution finest");
+	ASSERT_EQ(r.exit_code, 0) << r.output;
+	expectTransformMatchesTruth(slurp(d + "/b.json"));
+	const auto merged = loadGridMap(d + "/merged.yaml");
+	EXPECT_NEAR(merged.getResolution(), 0.05, 1e-4);
+	EXPECT_TRUE(fs::exists(d + "/merged.pgm"));
+	// An explicit output resolution.
+	const CliRun r2 = runCli(d + "/ref.yaml " + d + "/other.yaml --out " + d + "/m10.gridmap.gz --output-resolution 0.1");
+	ASSERT_EQ(r2.exit_code, 0) << r2.output;
+	EXPECT_NEAR(loadGridMap(d + "/m10.gridmap.gz").getResolution(), 0.1, 1e-6);
+}
+
+TEST(Cli, SimplemapInputsRenderedAtTheGivenResolution)
+{
+	// The same real simplemap as both inputs: truth is identity in metres.
+	const std::string sm = test::mrptDataset("localization_demo.simplemap.gz");
+	const std::string d = dir();
+	const CliRun r = runCli(sm + " " + sm + " --simplemap-resolution 0.06 --json " + d + "/c.json");
+	ASSERT_EQ(r.exit_code, 0) << r.output;
+	const std::string j = slurp(d + "/c.json");
+	EXPECT_NEAR(jsonNumber(j, "x"), 0, 0.02);
+	EXPECT_NEAR(jsonNumber(j, "y"), 0, 0.02);
+	EXPECT_NEAR(jsonNumber(j, "scale"), 1, 0.002);
+}
+
+TEST(Cli, DifferentBuildingsExitOneAndWriteOnlyTheJson)
+{
+	const std::string d = dir();
+	const CliRun r = runCli(
+		test::mrptDataset("malaga-cs-fac-building.simplemap.gz") + " " +
+		test::mrptDataset("localization_demo.simplemap.gz") + " --json " + d + "/d.json --out " + d +
+		"/never.gridmap.gz --png " + d + "/never.png");
+	EXPECT_EQ(r.exit_code, 1) << r.output;
+	EXPECT_NE(r.output.find("NOT MERGED"), std::string::npos) << r.output;
+	const std::string j = slurp(d + "/d.json");
+	EXPECT_NE(j.find("\"success\": false"), std::string::npos) << j;
+	EXPECT_EQ(j.find("\"error\": \"\""), std::string::npos) << j;
+	EXPECT_FALSE(fs::exists(d + "/never.gridmap.gz"));
+	EXPECT_FALSE(fs::exists(d + "/never.png"));
+}
+
+TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
+{
+	const std::string d = dir();
+	std::ofstream(d + "/garbage.gridmap.gz") << "garbage";
+	saveGridMap(malagaPair().ref, d + "/ok.gridmap.gz");
+	struct Bad
+	{
+		std::string args, words;
+	};
+	for (const Bad& b : {
+			 Bad{d + "/nope.gridmap.gz " + d + "/ok.gridmap.gz", "nope.gridmap.gz': no such file"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/garbage.gridmap.gz", "garbage.gridmap.gz': not a serialized"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --output-resolution fine", "--output-resolution"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --out x.png", "--out must end"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --config " + d + "/none.ini", "none.ini': no such config"},
+			 Bad{d + "/ok.gridmap.gz", "OTHER"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --bogus", "bogus"},
+		 })
+	{
+		SCOPED_TRACE(b.args);
+		const CliRun r = runCli(b.args);
+		EXPECT_EQ(r.exit_code, 2) << r.output;
+		EXPECT_NE(r.output.find(b.words), std::string::npos) << r.output;
+	}
+}

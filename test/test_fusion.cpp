@@ -1,0 +1,154 @@
+// Fusion and map I/O: the cell rule, extents and origins on hand-made grids,
+// round trips of every output format.
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GridMapFusion.h>
+#include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/MapIO.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "test_data.h"
+
+using namespace multires_map_merge;
+using mrpt::maps::COccupancyGridMap2D;
+
+namespace
+{
+// Sets the cell containing (x, y) to an occupancy probability.
+void setOcc(COccupancyGridMap2D& g, double x, double y, float p_occ)
+{
+	g.setCell(g.x2idx(x), g.y2idx(y), 1.0f - p_occ);
+}
+float occAt(const COccupancyGridMap2D& g, double x, double y)
+{
+	return occupancyProbability(g, g.x2idx(x), g.y2idx(y));
+}
+std::string tmp(const std::string& name) { return ::testing::TempDir() + "/" + name; }
+}  // namespace
+
+TEST(FuseCell, RuleTable)
+{
+	const float occ = 0.9f, occ_weak = 0.6f, fr = 0.1f, fr_weak = 0.4f, unk = 0.5f;
+	EXPECT_EQ(classify(fuseCell(occ, fr)), kOccupied);
+	EXPECT_EQ(classify(fuseCell(fr, occ_weak)), kOccupied);
+	EXPECT_EQ(classify(fuseCell(occ, unk)), kOccupied);
+	EXPECT_EQ(classify(fuseCell(fr, unk)), kFree);
+	EXPECT_EQ(classify(fuseCell(unk, fr_weak)), kFree);
+	EXPECT_EQ(classify(fuseCell(unk, unk)), kUnknown);
+	// The stronger evidence of the winning class is kept.
+	EXPECT_FLOAT_EQ(fuseCell(occ_weak, occ), occ);
+	EXPECT_FLOAT_EQ(fuseCell(fr_weak, fr), fr);
+	EXPECT_FLOAT_EQ(fuseCell(unk, unk), 0.5f);
+}
+
+TEST(Fusion, UnionOfExtentsInTheReferenceFrame)
+{
+	COccupancyGridMap2D ref(0, 1, 0, 1, 0.1f), other(0, 1, 0, 1, 0.05f);
+	setOcc(ref, 0.55, 0.55, 0.1f);  // free in ref
+	setOcc(other, 0.52, 0.52, 0.9f);  // occupied in other's own frame
+	// other's frame sits 2 m along x in ref's frame.
+	const FusedMap f = fuseGridMaps(ref, other, Similarity2D(1, 0, {2, 0}), 0.1);
+	EXPECT_NEAR(f.merged.getXMin(), 0.0, 1e-6);
+	EXPECT_NEAR(f.merged.getXMax(), 3.0, 1e-6);
+	EXPECT_NEAR(f.merged.getYMax(), 1.0, 1e-6);
+	EXPECT_EQ(f.merged.getSizeX(), 30u);
+	EXPECT_EQ(f.merged.getSizeY(), 10u);
+	EXPECT_EQ(classify(occAt(f.merged, 0.55, 0.55)), kFree);
+	EXPECT_EQ(classify(occAt(f.merged, 2.52, 0.52)), kOccupied);
+	EXPECT_EQ(classify(occAt(f.merged, 1.5, 0.5)), kUnknown);  // between the maps
+	EXPECT_EQ(f.ref_classes.size(), cv::Size(30, 10));
+}
+
+TEST(Fusion, RotationScaleAndOriginsHonoured)
+{
+	// other's grid starts at (-3, 4); its frame is rotated 90° and its stated
+	// metres are half the reference's (scale 2).
+	COccupancyGridMap2D ref(-1, 1, -1, 1, 0.1f), other(-3, -2, 4, 5, 0.05f);
+	for (int i = -1; i <= 1; ++i)
+		for (int j = -1; j <= 1; ++j) setOcc(other, -2.475 + 0.05 * i, 4.475 + 0.05 * j, 0.95f);
+	const Similarity2D t(2.0, M_PI / 2, {1, 1});
+	const Eigen::Vector2d where = t(Eigen::Vector2d(-2.475, 4.475));
+	const FusedMap f = fuseGridMaps(ref, other, t, 0.1);
+	EXPECT_EQ(classify(occAt(f.merged, where.x(), where.y())), kOccupied);
+	EXPECT_LE(f.merged.getXMin(), where.x());
+	EXPECT_GE(f.merged.getYMax(), where.y());
+}
+
+TEST(Fusion, AOneCellWallSurvivesACoarserOutput)
+{
+	COccupancyGridMap2D ref(0, 2, 0, 2, 0.1f), other(0, 2, 0, 2, 0.02f);
+	for (double x = 0.01; x < 2; x += 0.02)
+		for (double y = 0.01; y < 2; y += 0.02) setOcc(other, x, y, std::abs(y - 1.01) < 0.005 ? 0.9f : 0.1f);
+	const FusedMap f = fuseGridMaps(ref, other, Similarity2D(), 0.1);
+	for (double x = 0.05; x < 2; x += 0.1) EXPECT_EQ(classify(occAt(f.merged, x, 1.01)), kOccupied) << x;
+	EXPECT_EQ(classify(occAt(f.merged, 1.0, 0.5)), kFree);
+}
+
+TEST(Fusion, RefusesAbsurdSizesAndBadArguments)
+{
+	COccupancyGridMap2D a(0, 1, 0, 1, 0.1f);
+	EXPECT_THROW(fuseGridMaps(a, a, Similarity2D(), 0.0), std::invalid_argument);
+	EXPECT_THROW(fuseGridMaps(a, a, Similarity2D(), NAN), std::invalid_argument);
+	EXPECT_THROW(fuseGridMaps(a, a, Similarity2D(0, 0, {0, 0}), 0.1), std::invalid_argument);
+	EXPECT_THROW(fuseGridMaps(a, a, Similarity2D(1, 0, {1e6, 0}), 0.01), std::invalid_argument);
+}
+
+TEST(MapIO, EveryOutputFormatRoundTripsOnARealMap)
+{
+	const ScanSequence s = loadScans(test::mrptDataset("malaga-cs-fac-building.simplemap.gz"));
+	const COccupancyGridMap2D g = renderGrid(s, 0, 50, 0.08);
+	const cv::Mat classes = toClassImage(g);
+	for (const std::string name : {"rt.gridmap.gz", "rt.gridmap", "rt.yaml"})
+	{
+		SCOPED_TRACE(name);
+		saveGridMap(g, tmp(name));
+		const COccupancyGridMap2D back = loadGridMap(tmp(name));
+		ASSERT_EQ(back.getSizeX(), g.getSizeX());
+		ASSERT_EQ(back.getSizeY(), g.getSizeY());
+		EXPECT_NEAR(back.getResolution(), g.getResolution(), 1e-6);
+		EXPECT_NEAR(back.getXMin(), g.getXMin(), 1e-3);
+		EXPECT_NEAR(back.getYMin(), g.getYMin(), 1e-3);
+		EXPECT_EQ(cv::countNonZero(toClassImage(back) != classes), 0);  // not mirrored
+	}
+}
+
+TEST(MapIO, BadFilesGiveErrorsNamingTheFile)
+{
+	auto expectError = [](const std::string& path, const std::string& words) {
+		try
+		{
+			loadGridMap(path);
+			ADD_FAILURE() << "no error for " << path;
+		}
+		catch (const MapIOError& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+			EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+		}
+	};
+	expectError(tmp("missing.gridmap.gz"), "no such file");
+	std::ofstream(tmp("garbage.gridmap.gz")) << "not a map at all";
+	expectError(tmp("garbage.gridmap.gz"), "not a serialized");
+	std::ofstream(tmp("empty.gridmap")).close();
+	expectError(tmp("empty.gridmap"), "not a serialized");
+	std::ofstream(tmp("m.txt")) << "x";
+	expectError(tmp("m.txt"), "unknown map format");
+	std::ofstream(tmp("noimage.yaml")) << "image: nowhere.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n"
+									   << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	expectError(tmp("noimage.yaml"), "unreadable");
+}
+
+TEST(MapIO, ReadsTheRealWillowMapServerFiles)
+{
+	MMM_REQUIRE_SHARED(yaml, "ros_maps/willow/navstage_willow_10cm.yaml");
+	const COccupancyGridMap2D g = loadGridMap(yaml);
+	EXPECT_EQ(g.getSizeX(), 584u);
+	EXPECT_EQ(g.getSizeY(), 526u);
+	EXPECT_NEAR(g.getResolution(), 0.1, 1e-6);
+	const cv::Mat c = toClassImage(g);
+	EXPECT_GT(cv::countNonZero(c == kOccupied), 5000);
+	EXPECT_GT(cv::countNonZero(c == kFree), 50000);
+}
