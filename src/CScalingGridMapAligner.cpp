@@ -213,8 +213,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		why << "alignment not confident enough (confidence " << info.confidence << " < "
 			<< options.min_confidence << "; cell consistency " << info.consistency << ", overlap "
 			<< info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
-		auto out = fail(why.str());
-		return out;
+		return fail(why.str());
 	}
 	info.success = true;
 	info.message = "merged";

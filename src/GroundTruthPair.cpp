@@ -1,5 +1,6 @@
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/MapIO.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/CSimpleMap.h>
@@ -19,12 +20,6 @@ using mrpt::maps::COccupancyGridMap2D;
 
 namespace
 {
-bool endsWith(const std::string& s, const std::string& suffix)
-{
-	return s.size() >= suffix.size() &&
-		s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 std::string readMaybeGzipped(const std::string& path)
 {
 	// CFileGZInputStream reads plain files too.
@@ -81,9 +76,9 @@ ScanSequence loadCarmenScans(const std::string& path)
 
 ScanSequence loadScans(const std::string& path)
 {
-	if (endsWith(path, ".simplemap") || endsWith(path, ".simplemap.gz"))
+	if (hasSuffix(path, ".simplemap") || hasSuffix(path, ".simplemap.gz"))
 		return loadSimplemapScans(path);
-	if (endsWith(path, ".log") || endsWith(path, ".log.gz")) return loadCarmenScans(path);
+	if (hasSuffix(path, ".log") || hasSuffix(path, ".log.gz")) return loadCarmenScans(path);
 	throw std::runtime_error(
 		"'" + path + "': expected a .simplemap(.gz) or a CARMEN .log(.gz)");
 }
