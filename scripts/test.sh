@@ -7,6 +7,9 @@ build=${BUILD_DIR:-$here/build}
 cmake --build "$build" -j2 --target tests
 # ROS tools write here; keep them out of $HOME.
 export ROS_HOME="$build/ros_home" ROS_LOG_DIR="$build/ros_home/log"
+# rostest's master and nodes talk over loopback only.
+export ROS_IP=127.0.0.1
+unset ROS_HOSTNAME ROS_MASTER_URI
 mkdir -p "$ROS_LOG_DIR"
 cd "$build"
 ctest --output-on-failure

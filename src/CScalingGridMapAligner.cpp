@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace multires_map_merge
 {
@@ -38,6 +39,33 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(min_confidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(use_resolution_metadata, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(metadata_scale_tolerance, double, c, s);
+	if (const std::string why = invalidReason(); !why.empty())
+		throw std::invalid_argument("[" + s + "] " + why);
+}
+
+std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
+{
+	std::ostringstream why;
+	auto in = [&](const char* name, double v, double lo, double hi) {
+		if (!(v >= lo && v <= hi) && why.tellp() == 0)
+			why << name << " = " << v << " is outside [" << lo << ", " << hi << "]";
+	};
+	in("pyramid_levels", pyramid_levels, 1, 8);
+	in("sift_contrast_threshold", sift_contrast_threshold, 0, 1);
+	in("sift_edge_threshold", sift_edge_threshold, 1, 1e3);
+	in("ratio_test", ratio_test, 0.1, 1);
+	in("ransac_threshold", ransac_threshold, 0.1, 100);
+	in("ransac_iterations", ransac_iterations, 1, 1e6);
+	in("ransac_min_inliers", ransac_min_inliers, 2, 1e9);
+	in("hypotheses_per_level_pair", hypotheses_per_level_pair, 1, 100);
+	in("max_hypotheses", max_hypotheses, 1, 1000);
+	in("xi_min", xi_min, 0.05, 1);
+	in("lambda", lambda, 0, 100);
+	in("icp_max_iterations", icp_max_iterations, 1, 1e5);
+	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
+	in("min_confidence", min_confidence, 0, 1);
+	in("metadata_scale_tolerance", metadata_scale_tolerance, 0, 10);
+	return why.str();
 }
 
 void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
@@ -125,12 +153,22 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		MRPT_LOG_INFO_STREAM("not merged: " << why);
 		return info;
 	};
+	if (const std::string why = options.invalidReason(); !why.empty())
+		return fail("invalid parameters: " + why);
 	for (const auto& why : {checkGrid(ref, "reference"), checkGrid(other, "other")})
 		if (!why.empty()) return fail(why);
 
 	// 1. Maps as images; features over a resolution pyramid; RANSAC.
 	stage.Tic();
 	const cv::Mat ref_img = toClassImage(ref), other_img = toClassImage(other);
+	for (const auto& [img, which] : {std::pair{&ref_img, "reference"}, std::pair{&other_img, "other"}})
+	{
+		// Said plainly here rather than as "no feature matches" later.
+		const int occupied = cv::countNonZero(*img == kOccupied);
+		if (occupied + cv::countNonZero(*img == kFree) == 0)
+			return fail(std::string(which) + " map is all unknown: nothing to align");
+		if (occupied == 0) return fail(std::string(which) + " map has no occupied cells: nothing to align");
+	}
 	const FeatureParams fp = options.featureParams();
 	const auto ref_feats = extractPyramidFeatures(ref_img, fp);
 	const auto other_feats = extractPyramidFeatures(other_img, fp);

@@ -95,10 +95,13 @@ COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolu
 	return g;
 }
 
-void saveGridMap(const COccupancyGridMap2D& grid, const std::string& path)
+void saveGridMap(const COccupancyGridMap2D& grid, const std::string& path, const Similarity2D& frame)
 {
+	const bool identity = frame.scale == 1 && frame.yaw == 0 && frame.t.isZero();
 	if (hasSuffix(path, ".gridmap") || hasSuffix(path, ".gridmap.gz"))
 	{
+		// MRPT snaps a grid's corner to whole cells: an arbitrary frame would shift it.
+		if (!identity) fail(path, "a .gridmap cannot hold the map's origin pose exactly; save as .yaml");
 		mrpt::io::CFileGZOutputStream out;
 		if (!out.open(path, hasSuffix(path, ".gz") ? 6 : 0)) fail(path, "cannot write");
 		auto arch = mrpt::serialization::archiveFrom(out);
@@ -114,10 +117,12 @@ void saveGridMap(const COccupancyGridMap2D& grid, const std::string& path)
 		img.setTo(205, img == kUnknown);
 		// map_server images have +y up: the first row is the top of the map.
 		if (!cv::imwrite(pgm.string(), forDisplay(img))) fail(pgm.string(), "cannot write");
+		const Eigen::Vector2d corner = frame.apply({grid.getXMin(), grid.getYMin()});
 		std::ofstream y(path);
+		y.precision(12);
 		y << "image: " << pgm.filename().string() << "\n"
 		  << "resolution: " << grid.getResolution() << "\n"
-		  << "origin: [" << grid.getXMin() << ", " << grid.getYMin() << ", 0.0]\n"
+		  << "origin: [" << corner.x() << ", " << corner.y() << ", " << frame.yaw << "]\n"
 		  << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
 		if (!y) fail(path, "cannot write");
 		return;

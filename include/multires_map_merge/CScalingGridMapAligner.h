@@ -57,6 +57,11 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 
+		/** Why these values cannot work ("" when they can): out-of-range or
+		 * non-finite values. loadFromConfigFile throws std::invalid_argument
+		 * with it; alignScaled reports it as not merged. */
+		std::string invalidReason() const;
+
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
 	} options;
@@ -67,7 +72,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		std::string message;  //!< why not, when not
 		/** x_ref = metric(x_other), metres, each map read with its stated metadata. */
 		Similarity2D metric;
-		/** The same between cell coordinates; cells.scale = other cells per ref cell. */
+		/** The same between cell coordinates; cells.scale = reference cells per
+		 * cell of other (other's cell size in reference cells). */
 		Similarity2D cells;
 		/** The feature (RANSAC) estimate TsICP started from, cell coordinates. */
 		Similarity2D initial_cells;

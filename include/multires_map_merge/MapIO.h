@@ -2,6 +2,8 @@
 // Reading and writing grid maps by file extension. Every failure throws
 // MapIOError with a message that names the file and the problem.
 
+#include <multires_map_merge/Similarity2D.h>
+
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include <stdexcept>
@@ -21,8 +23,11 @@ mrpt::maps::COccupancyGridMap2D loadGridMap(
 	const std::string& path, double simplemap_resolution = 0.05);
 
 /** Saves .gridmap.gz / .gridmap, or map_server .yaml plus a .pgm beside it
- * (occupied 0, free 254, unknown 205; origin = the grid's lower-left corner). */
-void saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
+ * (occupied 0, free 254, unknown 205; origin = the grid's lower-left corner).
+ * `frame` (rigid) places the grid's metric frame in the file's frame; only a
+ * .yaml origin [x, y, yaw] can hold a non-identity one exactly. */
+void saveGridMap(
+	const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path, const Similarity2D& frame = {});
 
 bool hasSuffix(const std::string& s, const std::string& suffix);
 

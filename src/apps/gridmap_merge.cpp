@@ -1,10 +1,13 @@
 // gridmap-merge: aligns and fuses two saved grid maps whose resolutions may
-// differ (or be wrongly stated). Exit codes: 0 merged, 1 no confident
-// alignment (only the JSON is written), 2 bad input or usage.
+// differ (or be wrongly stated), or the last nav_msgs/OccupancyGrid on two
+// topics of a rosbag. Exit codes: 0 merged, 1 no confident alignment (only
+// the JSON is written), 2 bad input or usage.
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GridMapFusion.h>
 #include <multires_map_merge/MapIO.h>
 #include <multires_map_merge/MergeReport.h>
+#include <multires_map_merge/ros/BagMaps.h>
+#include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/CTicTac.h>
@@ -42,6 +45,49 @@ double outputResolution(const std::string& spec, double ref_res, double other_re
 	throw UsageError("--output-resolution must be 'reference', 'finest' or metres > 0, not '" + spec + "'");
 }
 
+/** Two maps, each in its metric frame, and where that frame sits in the
+ * frame the user names the map by (identity for files; a ROS map's origin
+ * pose for bag messages). */
+struct Inputs
+{
+	mrpt::maps::COccupancyGridMap2D ref, other;
+	Similarity2D ref_frame, other_frame;
+};
+
+Inputs fromFiles(const std::string& ref, const std::string& other, double simplemap_res)
+{
+	Inputs in;
+	in.ref = loadGridMap(ref, simplemap_res);
+	in.other = loadGridMap(other, simplemap_res);
+	return in;
+}
+
+Inputs fromBag(const std::string& bag, const std::vector<std::string>& topics)
+{
+	if (topics.size() != 2) throw UsageError("--topics needs two topics: REF_TOPIC OTHER_TOPIC");
+	Inputs in;
+	auto ref = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[0]).back(), topics[0]);
+	auto other = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[1]).back(), topics[1]);
+	in.ref = std::move(ref.grid);
+	in.other = std::move(other.grid);
+	in.ref_frame = ref.origin;
+	in.other_frame = other.origin;
+	return in;
+}
+
+/** TCLAP takes one value per flag: "--topics A B" becomes "--topics A --topics B". */
+std::vector<std::string> expandTopics(int argc, char** argv)
+{
+	std::vector<std::string> args(argv, argv + argc);
+	for (size_t i = 0; i + 2 < args.size(); ++i)
+		if (args[i] == "--topics" && args[i + 2].rfind("-", 0) != 0)
+		{
+			args.insert(args.begin() + i + 2, "--topics");
+			i += 2;
+		}
+	return args;
+}
+
 void writeText(const std::string& path, const std::string& text)
 {
 	std::ofstream f(path);
@@ -57,9 +103,16 @@ int main(int argc, char** argv)
 		"and written is the pose of OTHER's frame in REF's: x_ref = scale*R(yaw)*x_other + (x, y), "
 		"metres, each map read with its own stated metadata.",
 		' ', "0.1.0");
-	TCLAP::UnlabeledValueArg<std::string> ref_arg(
-		"REF", "reference map: .gridmap[.gz], map_server .yaml, .simplemap[.gz]", true, "", "REF", cmd);
-	TCLAP::UnlabeledValueArg<std::string> other_arg("OTHER", "map to align onto REF", true, "", "OTHER", cmd);
+	TCLAP::UnlabeledMultiArg<std::string> maps_arg(
+		"MAPS",
+		"REF OTHER: the reference map and the map to align onto it; each .gridmap[.gz], "
+		"map_server .yaml or .simplemap[.gz] (not with --bag)",
+		false, "REF OTHER", cmd);
+	TCLAP::ValueArg<std::string> bag_arg(
+		"", "bag", "merge the last nav_msgs/OccupancyGrid on two topics of this rosbag", false, "",
+		"FILE.bag", cmd);
+	TCLAP::MultiArg<std::string> topics_arg(
+		"", "topics", "with --bag: REF_TOPIC OTHER_TOPIC", false, "TOPIC", cmd);
 	TCLAP::ValueArg<std::string> json_arg("", "json", "write the result as JSON", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> out_arg(
 		"", "out", "write the merged map (.gridmap.gz or .yaml + .pgm)", false, "", "FILE", cmd);
@@ -81,7 +134,16 @@ int main(int argc, char** argv)
 	try
 	{
 		cmd.setExceptionHandling(false);
-		cmd.parse(argc, argv);
+		auto args = expandTopics(argc, argv);
+		cmd.parse(args);
+		for (const auto& m : maps_arg.getValue())  // TCLAP takes unknown flags as positionals
+			if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
+		const bool bag_mode = bag_arg.isSet();
+		if (bag_mode && !maps_arg.getValue().empty())
+			throw UsageError("give either --bag FILE --topics A B or two map files, not both");
+		if (!bag_mode && maps_arg.getValue().size() != 2)
+			throw UsageError("give two map files (REF OTHER), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
+		if (!bag_mode && topics_arg.isSet()) throw UsageError("--topics needs --bag");
 
 		CScalingGridMapAligner aligner;
 		if (config_arg.isSet())
@@ -98,14 +160,27 @@ int main(int argc, char** argv)
 			!hasSuffix(out_arg.getValue(), ".gridmap") && !hasSuffix(out_arg.getValue(), ".yaml"))
 			throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
 
-		const auto ref = loadGridMap(ref_arg.getValue(), smres_arg.getValue());
-		const auto other = loadGridMap(other_arg.getValue(), smres_arg.getValue());
-		std::cout << "REF   " << ref_arg.getValue() << ": " << ref.getSizeX() << "x" << ref.getSizeY()
+		const std::string ref_name = bag_mode ? bag_arg.getValue() + ":" + topics_arg.getValue()[0]
+											  : maps_arg.getValue()[0];
+		const std::string other_name = bag_mode ? bag_arg.getValue() + ":" + topics_arg.getValue()[1]
+												: maps_arg.getValue()[1];
+		const Inputs in = bag_mode ? fromBag(bag_arg.getValue(), topics_arg.getValue())
+								   : fromFiles(ref_name, other_name, smres_arg.getValue());
+		const bool framed = in.ref_frame.yaw != 0 || !in.ref_frame.t.isZero();
+		if (framed && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
+			throw UsageError(
+				"--out: " + ref_name + " has an origin pose only a .yaml map can hold exactly; save as .yaml");
+		const auto& ref = in.ref;
+		const auto& other = in.other;
+		std::cout << "REF   " << ref_name << ": " << ref.getSizeX() << "x" << ref.getSizeY()
 				  << " cells, stated " << ref.getResolution() << " m\n"
-				  << "OTHER " << other_arg.getValue() << ": " << other.getSizeX() << "x" << other.getSizeY()
+				  << "OTHER " << other_name << ": " << other.getSizeX() << "x" << other.getSizeY()
 				  << " cells, stated " << other.getResolution() << " m\n";
 
 		r = aligner.alignScaled(ref, other);
+		// Fusion works in the grids' frames; the report is between the maps' frames.
+		const Similarity2D grids_metric = r.metric;
+		r.metric = in.ref_frame.compose(r.metric).compose(in.other_frame.inverse());
 		double res = 0;
 		if (r.success) res = outputResolution(outres_arg.getValue(), ref.getResolution(), r.implied_resolution_other);
 		if (!r.success)
@@ -122,12 +197,12 @@ int main(int argc, char** argv)
 
 		if (out_arg.isSet() || png_arg.isSet())
 		{
-			const FusedMap fused = fuseGridMaps(ref, other, r.metric, res);
+			const FusedMap fused = fuseGridMaps(ref, other, grids_metric, res);
 			std::cout << "  merged map: " << fused.merged.getSizeX() << "x" << fused.merged.getSizeY()
 					  << " cells at " << fused.merged.getResolution() << " m\n";
 			if (out_arg.isSet())
 			{
-				saveGridMap(fused.merged, out_arg.getValue());
+				saveGridMap(fused.merged, out_arg.getValue(), in.ref_frame);
 				std::cout << "  wrote " << out_arg.getValue() << "\n";
 			}
 			if (png_arg.isSet())

@@ -1,0 +1,89 @@
+#include <multires_map_merge/ros/AlignerParamsFromRos.h>
+
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/system/string_utils.h>
+#include <ros/console.h>
+#include <ros/param.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+namespace multires_map_merge::ros1
+{
+namespace
+{
+/** The ini keys, as the parameters write them: one list, kept by TConfigParams. */
+std::vector<std::string> alignerKeys()
+{
+	mrpt::config::CConfigFileMemory ini;
+	CScalingGridMapAligner::TConfigParams().saveToConfigFile(ini, "aligner");
+	std::vector<std::string> keys;
+	ini.getAllKeys("aligner", keys);
+	for (auto& k : keys) k = mrpt::system::trim(k);  // MRPT pads keys to align the values
+	return keys;
+}
+
+std::string asIniValue(const std::string& key, XmlRpc::XmlRpcValue& v)
+{
+	std::ostringstream s;
+	s.precision(17);
+	switch (v.getType())
+	{
+		case XmlRpc::XmlRpcValue::TypeBoolean:
+			return static_cast<bool>(v) ? "true" : "false";
+		case XmlRpc::XmlRpcValue::TypeInt:
+			s << static_cast<int>(v);
+			return s.str();
+		case XmlRpc::XmlRpcValue::TypeDouble:
+			s << static_cast<double>(v);
+			return s.str();
+		default:
+			throw std::invalid_argument("parameter ~" + key + " must be a number or a boolean");
+	}
+}
+}  // namespace
+
+CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
+	const ros::NodeHandle& pnh, const std::vector<std::string>& node_keys)
+{
+	CScalingGridMapAligner::TConfigParams params;
+	std::string config_file, section = "aligner";
+	pnh.getParam("config_section", section);
+	if (pnh.getParam("config_file", config_file) && !config_file.empty())
+	{
+		if (!std::filesystem::is_regular_file(config_file))
+			throw std::invalid_argument("~config_file '" + config_file + "': no such file");
+		params.loadFromConfigFile(mrpt::config::CConfigFile(config_file), section);
+	}
+
+	const std::vector<std::string> keys = alignerKeys();
+	mrpt::config::CConfigFileMemory overrides;
+	for (const auto& key : keys)
+	{
+		XmlRpc::XmlRpcValue v;
+		if (pnh.getParam(key, v)) overrides.write("aligner", key, asIniValue(key, v));
+	}
+	params.loadFromConfigFile(overrides, "aligner");
+
+	// A misspelt key would otherwise leave its default in force unnoticed.
+	std::vector<std::string> names;
+	if (ros::param::getParamNames(names))
+	{
+		const std::string prefix = pnh.getNamespace() + "/";
+		for (const auto& name : names)
+		{
+			if (name.compare(0, prefix.size(), prefix) != 0) continue;
+			const std::string key = name.substr(prefix.size());
+			const bool known = std::count(keys.begin(), keys.end(), key) ||
+							   std::count(node_keys.begin(), node_keys.end(), key) ||
+							   key == "config_file" || key == "config_section";
+			if (!known) ROS_WARN_STREAM("parameter " << name << " is not one this node reads; ignored");
+		}
+	}
+	return params;
+}
+
+}  // namespace multires_map_merge::ros1

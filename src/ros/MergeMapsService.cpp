@@ -1,0 +1,107 @@
+#include <multires_map_merge/ros/MergeMapsService.h>
+#include <multires_map_merge/ros/OccupancyGridConversion.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace multires_map_merge::ros1
+{
+MergeMapsService::MergeMapsService(const CScalingGridMapAligner::TConfigParams& params) : params_(params)
+{
+	if (const std::string why = params_.invalidReason(); !why.empty())
+		throw std::invalid_argument("invalid aligner parameters: " + why);
+}
+
+namespace
+{
+/** The largest output the fusion may produce at `res`, in cells, estimated
+ * from both maps' extents (other's by its corners under the transform). */
+double mergedCells(
+	const mrpt::maps::COccupancyGridMap2D& ref, const mrpt::maps::COccupancyGridMap2D& other,
+	const Similarity2D& other_to_ref, double res)
+{
+	double x0 = ref.getXMin(), x1 = ref.getXMax(), y0 = ref.getYMin(), y1 = ref.getYMax();
+	for (const double x : {other.getXMin(), other.getXMax()})
+		for (const double y : {other.getYMin(), other.getYMax()})
+		{
+			const Eigen::Vector2d c = other_to_ref.apply({x, y});
+			x0 = std::min(x0, c.x()), x1 = std::max(x1, c.x());
+			y0 = std::min(y0, c.y()), y1 = std::max(y1, c.y());
+		}
+	return std::ceil((x1 - x0) / res + 1) * std::ceil((y1 - y0) / res + 1);
+}
+}  // namespace
+
+void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response& res, Details* details) const
+{
+	const auto start = std::chrono::steady_clock::now();
+	res = MergeMaps::Response();
+	res.success = false;
+	try
+	{
+		const double out_res_req = req.output_resolution;
+		if (!std::isfinite(out_res_req) || out_res_req < 0)
+		{
+			std::ostringstream why;
+			why << "output_resolution must be 0 (the reference's) or metres > 0, not " << out_res_req;
+			throw InvalidGridMessage(why.str());
+		}
+		const GridInFrame ref = gridFromMsg(req.reference, "reference");
+		const GridInFrame other = gridFromMsg(req.other, "other");
+
+		CScalingGridMapAligner aligner;
+		aligner.options = params_;
+		aligner.options.use_resolution_metadata = params_.use_resolution_metadata || req.use_resolution_metadata;
+		const auto info = aligner.alignScaled(ref.grid, other.grid);
+		if (details) details->info = info;
+		res.overlap = info.overlap;
+		res.confidence = info.confidence;
+		if (!info.success)
+			res.message = "not merged: " + info.message;
+		else
+		{
+			// Between the messages' frames: through each grid's origin frame.
+			const Similarity2D world = ref.origin.compose(info.metric).compose(other.origin.inverse());
+			res.transform.x = world.t.x();
+			res.transform.y = world.t.y();
+			res.transform.theta = world.yaw;
+			res.scale = world.scale;
+			res.scale_cells = info.cells.scale;
+			res.implied_resolution_other = info.implied_resolution_other;
+
+			const double out_res = out_res_req > 0 ? out_res_req : ref.grid.getResolution();
+			const double cells = mergedCells(ref.grid, other.grid, info.metric, out_res);
+			if (cells > double(max_merged_cells))
+			{
+				std::ostringstream why;
+				why << "aligned, but the merged map would have " << cells << " cells at " << out_res
+					<< " m (limit " << max_merged_cells << "); ask for a coarser output_resolution";
+				res.message = why.str();
+			}
+			else
+			{
+				FusedMap fused = fuseGridMaps(ref.grid, other.grid, info.metric, out_res, max_merged_cells);
+				res.merged = msgFromGrid(fused.merged, ref.origin, req.reference.header);
+				if (details) details->fused = std::move(fused);
+				res.success = true;
+				res.message = "merged";
+			}
+		}
+	}
+	catch (const std::bad_alloc&)
+	{
+		res.success = false;
+		res.message = "not merged: out of memory (maps too large for this machine)";
+	}
+	catch (const std::exception& e)
+	{
+		res.success = false;
+		res.message = std::string("not merged: ") + e.what();
+	}
+	if (!res.success) res.merged = nav_msgs::OccupancyGrid();
+	res.runtime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace multires_map_merge::ros1

@@ -1,0 +1,98 @@
+// merge_maps_node on a real master (rostest, loopback): the service answers
+// with the ground truth, publishes the merged map latched, refuses every bad
+// input without dying, and takes its parameters from an ini file and the
+// parameter server.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <atomic>
+#include <map>
+
+#include "ros_test_maps.h"
+
+using namespace multires_map_merge;
+using namespace multires_map_merge::test;
+
+namespace
+{
+const MsgPair& pair()
+{
+	static const MsgPair p = msgPair(malagaSpec(0.05, 0.08, 30), rigid(3, -1, 0.3), rigid(-20, 40, -1.0));
+	return p;
+}
+
+MergeMaps::Response call(const std::string& service, MergeMaps::Request req)
+{
+	// Wait for a node once; a node that never came up (or died) fails every
+	// later call at once instead of waiting again.
+	static std::map<std::string, bool> up;
+	if (!up.count(service)) up[service] = ros::service::waitForService(service, ros::Duration(120));
+	EXPECT_TRUE(up[service]) << service << " never came up";
+	MergeMaps srv;
+	srv.request = std::move(req);
+	EXPECT_TRUE(ros::service::call(service, srv)) << service << ": the call itself failed (node down?)";
+	return srv.response;
+}
+}  // namespace
+
+TEST(MergeMapsNode, ServesTheTruthAndLatchesTheMergedMap)
+{
+	ros::NodeHandle nh;
+	const MergeMaps::Response res = call("/merge_maps", validRequest(pair()));
+	expectTransformMatchesTruth(res, pair());
+	expectMergedGridIsRight(res, pair(), 0.05);
+
+	// Latched: a subscriber that comes after the call still gets it.
+	std::atomic<bool> got{false};
+	nav_msgs::OccupancyGrid latched;
+	ros::Subscriber sub = nh.subscribe<nav_msgs::OccupancyGrid>(
+		"/merged_map", 1, [&](const nav_msgs::OccupancyGrid::ConstPtr& m) {
+			latched = *m;
+			got = true;
+		});
+	const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30);
+	while (!got && ros::WallTime::now() < until)
+	{
+		ros::spinOnce();
+		ros::WallDuration(0.05).sleep();
+	}
+	ASSERT_TRUE(got) << "nothing latched on /merged_map";
+	EXPECT_EQ(latched.header.frame_id, pair().ref.header.frame_id);
+	EXPECT_EQ(latched.info.width, res.merged.info.width);
+	EXPECT_EQ(latched.info.height, res.merged.info.height);
+	EXPECT_EQ(latched.data, res.merged.data);
+}
+
+TEST(MergeMapsNode, EveryBadInputIsRefusedAndTheNodeKeepsServing)
+{
+	for (const BadRequest& c : badRequests())
+	{
+		SCOPED_TRACE(c.what);
+		MergeMaps::Request req = validRequest(pair());
+		c.spoil(req);
+		const MergeMaps::Response res = call("/merge_maps", req);
+		EXPECT_FALSE(res.success);
+		EXPECT_TRUE(saysAnyOf(res.message, c.says)) << res.message;
+	}
+	const MergeMaps::Response res = call("/merge_maps", validRequest(pair()));
+	expectTransformMatchesTruth(res, pair());
+}
+
+TEST(MergeMapsNode, IniFileIsReadAndPrivateParametersOverrideIt)
+{
+	// The ini asks for 100000 RANSAC inliers: nothing can merge.
+	const MergeMaps::Response strict = call("/from_ini/merge_maps", validRequest(pair()));
+	EXPECT_FALSE(strict.success);
+	EXPECT_TRUE(saysAnyOf(strict.message, "no consistent feature matches")) << strict.message;
+	// The same ini with ~ransac_min_inliers: 5 merges.
+	const MergeMaps::Response overridden = call("/ini_overridden/merge_maps", validRequest(pair()));
+	expectTransformMatchesTruth(overridden, pair());
+}
+
+int main(int argc, char** argv)
+{
+	::testing::InitGoogleTest(&argc, argv);
+	ros::init(argc, argv, "test_merge_maps_node");
+	ros::NodeHandle nh;  // keeps the node up for the whole run
+	return RUN_ALL_TESTS();
+}
