@@ -14,4 +14,7 @@ echo "Setting up and building (log: $log) ..."
 "$bin/gridmap-merge" "$out/ref.gridmap.gz" "$out/other.gridmap.gz" \
   --out "$out/merged.gridmap.gz" --png "$out/merged.png" --json "$out/result.json"
 echo
+echo "The same two maps as a robot would record them, merged from the bag:"
+"$bin/gridmap-merge" --bag "$out/two_robots.bag" --topics /robot1/map /robot2/map | grep -A1 "^merged"
+echo
 echo "Wrote the merged map, an overlay PNG and the JSON result into $out"

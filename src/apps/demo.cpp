@@ -3,11 +3,16 @@
 // their resolution metadata. Prints the estimate next to the truth.
 //   multires_demo [SIMPLEMAP]          align 5/8 cm and 2/10 cm pairs in-process
 //   multires_demo --write DIR          write the 5/8 cm pair as DIR/ref.gridmap.gz,
-//                                      DIR/other.gridmap.gz and print the truth
+//                                      DIR/other.gridmap.gz, and as two robots'
+//                                      nav_msgs/OccupancyGrid in DIR/two_robots.bag
+//                                      (/robot1/map, /robot2/map); print the truth
 //                                      (scripts/demo.sh then runs gridmap-merge)
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
+#include <multires_map_merge/ros/OccupancyGridConversion.h>
+
+#include <rosbag/bag.h>
 
 #include <filesystem>
 
@@ -32,12 +37,23 @@ int main(int argc, char** argv)
 			const std::string dir = argv[2];
 			saveGridMap(pair.ref, dir + "/ref.gridmap.gz");
 			saveGridMap(pair.other, dir + "/other.gridmap.gz");
+			{
+				// The same maps as two robots would publish them, each in its own frame.
+				rosbag::Bag bag(dir + "/two_robots.bag", rosbag::bagmode::Write);
+				std_msgs::Header h;
+				h.stamp = ros::Time(1);
+				h.frame_id = "robot1/map";
+				bag.write("/robot1/map", h.stamp, ros1::msgFromGrid(pair.ref, {}, h));
+				h.frame_id = "robot2/map";
+				bag.write("/robot2/map", h.stamp, ros1::msgFromGrid(pair.other, {}, h));
+			}
 			std::printf(
 				"Rendered two overlapping parts of the real malaga run:\n"
 				"  %s/ref.gridmap.gz   at 5 cm\n  %s/other.gridmap.gz at 8 cm, its frame rotated and shifted\n"
+				"  and both in %s/two_robots.bag on /robot1/map and /robot2/map\n"
 				"TRUTH: OTHER's frame in REF's: x 1.5 m, y -2.5 m, yaw 30 deg, scale 1; "
 				"OTHER's resolution 0.08 m (%.4f REF cells per OTHER cell)\n\n",
-				dir.c_str(), dir.c_str(), pair.otherCellsToRefCells().scale);
+				dir.c_str(), dir.c_str(), dir.c_str(), pair.otherCellsToRefCells().scale);
 			return 0;
 		}
 		const std::string simplemap = argc > 1 ? argv[1] : malaga;
