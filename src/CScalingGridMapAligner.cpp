@@ -164,10 +164,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	for (const auto& [img, which] : {std::pair{&ref_img, "reference"}, std::pair{&other_img, "other"}})
 	{
 		// Said plainly here rather than as "no feature matches" later.
-		const int occupied = cv::countNonZero(*img == kOccupied);
-		if (occupied + cv::countNonZero(*img == kFree) == 0)
-			return fail(std::string(which) + " map is all unknown: nothing to align");
+		const int occupied = cv::countNonZero(*img == kOccupied), free = cv::countNonZero(*img == kFree);
+		if (occupied + free == 0) return fail(std::string(which) + " map is all unknown: nothing to align");
 		if (occupied == 0) return fail(std::string(which) + " map has no occupied cells: nothing to align");
+		if (free == 0) return fail(std::string(which) + " map has no free cells: no walls to align");
 	}
 	const FeatureParams fp = options.featureParams();
 	const auto ref_feats = extractPyramidFeatures(ref_img, fp);

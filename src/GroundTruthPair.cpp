@@ -68,7 +68,24 @@ ScanSequence loadCarmenScans(const std::string& path)
 			if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(o)) scan = s;
 			if (auto d = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(o)) odo = d;
 		}
-		if (scan && odo) out.push_back({odo->odometry, scan});
+		if (!scan || !odo) continue;
+		// FLASER scans span 180° (SOURCES.md of the data; CARMEN's front laser).
+		// MRPT's parser guesses 90° for 180-beam lines, which smears such maps.
+		// CARMEN's beam i sits at -90° + i·180°/(n-1) for n odd (181, 361) and
+		// at -90° + i·180°/n for n even (180, 360); MRPT spreads n beams over
+		// the aperture end to end, centred on the sensor yaw.
+		const size_t n = scan->getScanSize();
+		if (n >= 2)
+		{
+			if (n % 2 == 1)
+				scan->aperture = static_cast<float>(M_PI);
+			else
+			{
+				scan->aperture = static_cast<float>(M_PI * (n - 1) / n);
+				scan->sensorPose.setYawPitchRoll(-M_PI / (2.0 * n), 0, 0);
+			}
+		}
+		out.push_back({odo->odometry, scan});
 	}
 	if (out.empty()) throw std::runtime_error("CARMEN log '" + path + "' holds no FLASER scans");
 	return out;

@@ -211,3 +211,17 @@ TEST(Config, IniRoundTripAndOverride)
 	EXPECT_DOUBLE_EQ(c.xi_min, 0.35);
 }
 }  // namespace
+
+TEST(Carmen, HundredEightyBeamScansSpanHalfACircle)
+{
+	// MRPT's CARMEN parser reads 180-beam FLASER lines as 90°, which smears
+	// the Intel lab beyond recognition; the loader corrects it, so the
+	// Intel halves align like any other pair.
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/intel-corrected.log.gz");
+	const ScanSequence& scans = scansOf(log);
+	ASSERT_EQ(scans.front().scan->getScanSize(), 180u);
+	EXPECT_NEAR(scans.front().scan->aperture, M_PI * 179 / 180, 1e-6);
+	CScalingGridMapAligner aligner;
+	const auto pair = makePair(scans, Case{"intel", 0.05, 0.08, 120, 0.6});
+	expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
+}
