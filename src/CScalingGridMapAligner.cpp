@@ -39,6 +39,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(min_confidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(use_resolution_metadata, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(metadata_scale_tolerance, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(max_map_cells, double, c, s);
 	if (const std::string why = invalidReason(); !why.empty())
 		throw std::invalid_argument("[" + s + "] " + why);
 }
@@ -65,6 +66,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
 	in("min_confidence", min_confidence, 0, 1);
 	in("metadata_scale_tolerance", metadata_scale_tolerance, 0, 10);
+	in("max_map_cells", max_map_cells, 64, 1e10);
 	return why.str();
 }
 
@@ -87,6 +89,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(min_confidence, "Below this the maps are reported as not merged");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(use_resolution_metadata, "Use the stated resolutions as a scale prior");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(metadata_scale_tolerance, "Relative scale tolerance of that prior");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(max_map_cells, "Larger maps are refused (bounds peak memory)");
 }
 
 FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
@@ -131,10 +134,14 @@ std::string checkGrid(const COccupancyGridMap2D& g, const char* which)
 
 // Confidence in [0,1] from the cell agreement, discounted when the overlap
 // TsICP settled on is pinned at ξmin (the sign of a wrong start) or when the
-// fitted edges sit far apart.
+// fitted edges sit far apart. A pinned ξ whose pairs fit to a fraction of a
+// cell is no such sign: maps whose edges coincide exactly on part of the
+// overlap (same resolution, whole-cell offsets) make ψ = 0 there, and any
+// larger ξ loses to it.
 double confidenceOf(double consistency, double overlap, double xi_min, double rmse_coarse)
 {
-	const double pinned = std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0);
+	const double exact = std::clamp((0.5 - rmse_coarse) / 0.2, 0.0, 1.0);
+	const double pinned = std::max(exact, std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0));
 	const double tight = std::clamp(1.5 - rmse_coarse, 0.0, 1.0);
 	const double agree = std::clamp((consistency - 0.7) / 0.25, 0.0, 1.0);
 	return agree * std::min(pinned, tight);
@@ -157,6 +164,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		return fail("invalid parameters: " + why);
 	for (const auto& why : {checkGrid(ref, "reference"), checkGrid(other, "other")})
 		if (!why.empty()) return fail(why);
+	for (const auto& [g, which] : {std::pair{&ref, "reference"}, std::pair{&other, "other"}})
+		if (double(g->getSizeX()) * g->getSizeY() > options.max_map_cells)
+		{
+			std::ostringstream why;
+			why << which << " map is too large (" << g->getSizeX() << "x" << g->getSizeY() << " cells > max_map_cells = "
+				<< options.max_map_cells << "); resample it coarser or raise max_map_cells (memory grows with it)";
+			return fail(why.str());
+		}
 
 	// 1. Maps as images; features over a resolution pyramid; RANSAC.
 	stage.Tic();

@@ -166,3 +166,14 @@ TEST(HostileMaps, MirroredMapIsNotMerged)
 	const auto r = CScalingGridMapAligner().alignScaled(g, mirrored);
 	EXPECT_FALSE(r.success) << "a mirrored map merged with confidence " << r.confidence;
 }
+
+TEST(HostileMaps, HugeMapIsRefusedBeforeAnyWork)
+{
+	// 10000 x 10000 cells (100 MB as an MRPT grid): above max_map_cells, so
+	// refused at once with the reason, instead of a bad_alloc later.
+	const COccupancyGridMap2D huge(0, 1000, 0, 1000, 0.1f);
+	ASSERT_EQ(huge.getSizeX(), 10000u);
+	const auto r = CScalingGridMapAligner().alignScaled(realMap(), huge);
+	EXPECT_FALSE(r.success);
+	EXPECT_NE(r.message.find("too large"), std::string::npos) << r.message;
+}

@@ -51,6 +51,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Trust the stated resolutions as a prior on the scale. */
 		bool use_resolution_metadata = false;
 		double metadata_scale_tolerance = 0.15;  //!< relative, with use_resolution_metadata
+		// --- Limits
+		/** Larger maps are refused before any work, so peak memory stays
+		 * bounded (README "Limits" states the bound per cell). */
+		double max_map_cells = 32e6;
 
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
