@@ -11,5 +11,6 @@ export ROS_HOME="$build/ros_home" ROS_LOG_DIR="$build/ros_home/log"
 export ROS_IP=127.0.0.1
 unset ROS_HOSTNAME ROS_MASTER_URI
 mkdir -p "$ROS_LOG_DIR"
-cd "$build"
-ctest --output-on-failure
+(cd "$build" && ctest --output-on-failure)
+# Fuzz the loaders and the aligner briefly (ASan + UBSan, clang build).
+"$here/scripts/fuzz.sh" 50

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 
 namespace multires_map_merge
 {
@@ -54,6 +56,86 @@ COccupancyGridMap2D loadSerialized(const std::string& path)
 	}
 	return g;
 }
+
+/** The map_server YAML keys, read line by line: the format is flat, and a
+ * general YAML parser (MRPT's libfyaml) hangs on some corrupt files (found
+ * by fuzzing). */
+COccupancyGridMap2D loadMapServerYaml(const std::string& path)
+{
+	std::ifstream in(path);
+	if (!in) fail(path, "cannot open");
+	std::map<std::string, std::string> kv;
+	std::string line;
+	for (int n = 0; std::getline(in, line); ++n)
+	{
+		if (n > 1000 || line.size() > 4096) fail(path, "not a map_server YAML (too long)");
+		line = line.substr(0, line.find('#'));
+		const size_t colon = line.find(':');
+		if (colon == std::string::npos) continue;
+		auto trim = [](std::string t) {
+			const size_t a = t.find_first_not_of(" \t\r\"'"), b = t.find_last_not_of(" \t\r\"'");
+			return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
+		};
+		kv[trim(line.substr(0, colon))] = trim(line.substr(colon + 1));
+	}
+	auto number = [&](const std::string& key, const std::string& text) {
+		try
+		{
+			size_t used = 0;
+			const double v = std::stod(text, &used);
+			if (used == text.size() && std::isfinite(v)) return v;
+		}
+		catch (const std::exception&)
+		{
+		}
+		fail(path, key + " must be a finite number, not '" + text + "'");
+	};
+	for (const char* key : {"image", "resolution", "origin"})
+		if (!kv.count(key)) fail(path, std::string("unreadable map_server YAML: no '") + key + "'");
+	const double res = number("resolution", kv["resolution"]);
+	if (!(res > 0)) fail(path, "invalid resolution " + kv["resolution"]);
+	std::string origin = kv["origin"];
+	if (origin.size() < 2 || origin.front() != '[' || origin.back() != ']')
+		fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
+	std::vector<double> o;
+	std::stringstream items(origin.substr(1, origin.size() - 2));
+	for (std::string item; std::getline(items, item, ',');)
+	{
+		const size_t a = item.find_first_not_of(' '), b = item.find_last_not_of(' ');
+		o.push_back(number("origin", a == std::string::npos ? "" : item.substr(a, b - a + 1)));
+	}
+	if (o.size() < 2 || o.size() > 3) fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
+	if (o.size() == 3 && o[2] != 0) fail(path, "a rotated origin (yaw " + std::to_string(o[2]) + ") is not supported");
+	const bool negate = kv.count("negate") && number("negate", kv["negate"]) != 0;
+	const double occ_th = kv.count("occupied_thresh") ? number("occupied_thresh", kv["occupied_thresh"]) : 0.65;
+	const double free_th = kv.count("free_thresh") ? number("free_thresh", kv["free_thresh"]) : 0.196;
+
+	std::filesystem::path image(kv["image"]);
+	if (image.is_relative()) image = std::filesystem::path(path).parent_path() / image;
+	if (!std::filesystem::is_regular_file(image)) fail(path, "unreadable map_server YAML or image (no image '" + image.string() + "')");
+	cv::Mat img;
+	try
+	{
+		img = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
+	}
+	catch (const cv::Exception& e)
+	{
+		fail(path, "unreadable map_server YAML or image (" + std::string(e.what()) + ")");
+	}
+	if (img.empty()) fail(path, "unreadable map_server YAML or image ('" + image.string() + "' is not an image)");
+	// map_server's trinary rule; images have +y up, grids row = cy.
+	const cv::Mat rows = forDisplay(img);
+	COccupancyGridMap2D g(
+		float(o[0]), float(o[0] + rows.cols * res), float(o[1]), float(o[1] + rows.rows * res), float(res));
+	for (int cy = 0; cy < rows.rows && cy < int(g.getSizeY()); ++cy)
+		for (int cx = 0; cx < rows.cols && cx < int(g.getSizeX()); ++cx)
+		{
+			const double v = rows.at<uint8_t>(cy, cx) / 255.0;
+			const double p_occ = negate ? v : 1 - v;
+			g.setCell(cx, cy, p_occ > occ_th ? 0.0f : (p_occ < free_th ? 1.0f : 0.5f));
+		}
+	return g;
+}
 }  // namespace
 
 COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolution)
@@ -63,18 +145,7 @@ COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolu
 	if (hasSuffix(path, ".gridmap") || hasSuffix(path, ".gridmap.gz"))
 		g = loadSerialized(path);
 	else if (hasSuffix(path, ".yaml") || hasSuffix(path, ".yml"))
-	{
-		bool ok = false;
-		try
-		{
-			ok = g.loadFromROSMapServerYAML(path);
-		}
-		catch (const std::exception& e)
-		{
-			fail(path, std::string("unreadable map_server YAML or image (") + e.what() + ")");
-		}
-		if (!ok) fail(path, "unreadable map_server YAML or image");
-	}
+		g = loadMapServerYaml(path);
 	else if (hasSuffix(path, ".simplemap") || hasSuffix(path, ".simplemap.gz"))
 	{
 		if (!std::isfinite(simplemap_resolution) || !(simplemap_resolution > 0))
