@@ -9,14 +9,7 @@ here=$(cd "$(dirname "$0")/.." && pwd)
 secs=${1:-50}
 build=${FUZZ_BUILD_DIR:-$here/build-fuzz}
 pkgs=(clang-14 libclang-rt-14-dev libomp-14-dev)
-missing=()
-for p in "${pkgs[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  sudo=""; [ "$(id -u)" -eq 0 ] || sudo=sudo
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"
-fi
+"$here/scripts/ensure_packages.sh" "${pkgs[@]}"
 CC=clang-14 CXX=clang++-14 cmake -S "$here" -B "$build" -DMMM_FUZZ=ON -DCATKIN_ENABLE_TESTING=OFF \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build "$build" -j2 --target fuzz_map_loader fuzz_aligner

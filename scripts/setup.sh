@@ -12,15 +12,7 @@ pkgs=(
   libmrpt-dev libmrpt-ros1bridge-dev mrpt-apps mrpt-common
   libopencv-dev libeigen3-dev libgtest-dev libtclap-dev
 )
-missing=()
-for p in "${pkgs[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if ((${#missing[@]})); then
-  sudo=""; [ "$(id -u)" -eq 0 ] || sudo=sudo
-  $sudo apt-get update
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${missing[@]}"
-fi
+"$here/scripts/ensure_packages.sh" "${pkgs[@]}"
 
 # The pyenv python3 on PATH cannot import Debian's python3-* modules (catkin_pkg, genmsg).
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release \

@@ -69,6 +69,14 @@ inline PairSpec malagaSpec(double ref_res, double other_res, double yaw_deg)
 
 inline Similarity2D rigid(double x, double y, double yaw) { return Similarity2D(1, yaw, {x, y}); }
 
+/** The malaga 5 vs 8 cm pair with both origins rotated (ros1bridge alone
+ * refuses such grids) and the frames far apart. */
+inline const MsgPair& rotatedOriginsPair()
+{
+	static const MsgPair p = msgPair(malagaSpec(0.05, 0.08, 30), rigid(3, -1, 0.3), rigid(-20, 40, -1.0));
+	return p;
+}
+
 /** The response's transform against the truth: scale and yaw, and the RMS
  * displacement of other's edge points below half a cell of the coarser map. */
 inline void expectTransformMatchesTruth(const MergeMaps::Response& res, const MsgPair& p)

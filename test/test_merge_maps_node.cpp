@@ -15,11 +15,7 @@ using namespace multires_map_merge::test;
 
 namespace
 {
-const MsgPair& pair()
-{
-	static const MsgPair p = msgPair(malagaSpec(0.05, 0.08, 30), rigid(3, -1, 0.3), rigid(-20, 40, -1.0));
-	return p;
-}
+const MsgPair& pair() { return rotatedOriginsPair(); }
 
 MergeMaps::Response call(const std::string& service, MergeMaps::Request req)
 {

@@ -13,16 +13,6 @@
 using namespace multires_map_merge;
 using namespace multires_map_merge::test;
 
-namespace
-{
-const MsgPair& rotatedOriginsPair()
-{
-	// Both origins rotated (ros1bridge alone refuses such grids), frames far apart.
-	static const MsgPair p = msgPair(malagaSpec(0.05, 0.08, 30), rigid(3, -1, 0.3), rigid(-20, 40, -1.0));
-	return p;
-}
-}  // namespace
-
 TEST(OccupancyGridConversion, RoundTripKeepsCellsAndOrigin)
 {
 	const auto grid = renderGrid(malagaScans(), 0, 30, 0.07);
@@ -66,12 +56,9 @@ TEST(MergeMapsService, RotatedOriginsGiveTheTruthBetweenFrames)
 {
 	const MsgPair& p = rotatedOriginsPair();
 	ros1::MergeMapsService service;
-	MergeMaps::Request req;
-	req.reference = p.ref;
-	req.other = p.other;
 	MergeMaps::Response res;
 	ros1::MergeMapsService::Details details;
-	service.merge(req, res, &details);
+	service.merge(validRequest(p), res, &details);
 	expectTransformMatchesTruth(res, p);
 	expectMergedGridIsRight(res, p, 0.05);
 	EXPECT_EQ(res.message, "merged");
@@ -84,9 +71,7 @@ TEST(MergeMapsService, OutputResolutionAndSizeLimit)
 {
 	const MsgPair& p = rotatedOriginsPair();
 	ros1::MergeMapsService service;
-	MergeMaps::Request req;
-	req.reference = p.ref;
-	req.other = p.other;
+	MergeMaps::Request req = validRequest(p);
 	req.output_resolution = 0.1;
 	MergeMaps::Response res;
 	service.merge(req, res);
@@ -134,10 +119,7 @@ TEST(MergeMapsService, ParametersAreCheckedAndUsed)
 
 	// A trusted resolution prior that the maps contradict leaves nothing to merge:
 	// the stated 8 cm are replaced by a lie of 4 cm.
-	const MsgPair& p = rotatedOriginsPair();
-	MergeMaps::Request req;
-	req.reference = p.ref;
-	req.other = p.other;
+	MergeMaps::Request req = validRequest(rotatedOriginsPair());
 	req.other.info.resolution = 0.04f;
 	MergeMaps::Response res;
 	ros1::MergeMapsService().merge(req, res);
