@@ -225,3 +225,26 @@ TEST(Carmen, HundredEightyBeamScansSpanHalfACircle)
 	const auto pair = makePair(scans, Case{"intel", 0.05, 0.08, 120, 0.6});
 	expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
 }
+
+TEST(Decision, RealMapsOfDifferentBuildingsFromTheSharedDataAreNeverMerged)
+{
+	// The confidence bar, checked on real negatives at mixed resolutions
+	// (the benchmark runs every ordered pair of six buildings).
+	MMM_REQUIRE_SHARED(fr079, "carmen_corrected/freiburg-079-corrected.log.gz");
+	MMM_REQUIRE_SHARED(intel, "carmen_corrected/intel-corrected.log.gz");
+	MMM_REQUIRE_SHARED(fr101, "carmen_corrected/freiburg-101-corrected.log.gz");
+	std::vector<mrpt::maps::COccupancyGridMap2D> maps;
+	for (const auto& [log, res] : {std::pair{fr079, 0.05}, std::pair{intel, 0.08}, std::pair{fr101, 0.04}})
+	{
+		const ScanSequence& s = scansOf(log);
+		maps.push_back(renderGrid(s, 0, s.size(), res));
+	}
+	CScalingGridMapAligner aligner;
+	for (size_t i = 0; i < maps.size(); ++i)
+		for (size_t j = 0; j < maps.size(); ++j)
+			if (i != j)
+			{
+				const auto r = aligner.alignScaled(maps[i], maps[j]);
+				EXPECT_FALSE(r.success) << i << " vs " << j << ": confidence " << r.confidence;
+			}
+}
