@@ -14,3 +14,5 @@ mkdir -p "$ROS_LOG_DIR"
 (cd "$build" && ctest --output-on-failure)
 # Fuzz the loaders and the aligner briefly (ASan + UBSan, clang build).
 "$here/scripts/fuzz.sh" 50
+# The whole suite again under ASan + UBSan (gcc build in build-asan/).
+"$here/scripts/sanitize.sh"

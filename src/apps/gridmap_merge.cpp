@@ -64,7 +64,6 @@ Inputs fromFiles(const std::string& ref, const std::string& other, double simple
 
 Inputs fromBag(const std::string& bag, const std::vector<std::string>& topics)
 {
-	if (topics.size() != 2) throw UsageError("--topics needs two topics: REF_TOPIC OTHER_TOPIC");
 	Inputs in;
 	auto ref = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[0]).back(), topics[0]);
 	auto other = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[1]).back(), topics[1]);
@@ -144,6 +143,8 @@ int main(int argc, char** argv)
 		if (!bag_mode && maps_arg.getValue().size() != 2)
 			throw UsageError("give two map files (REF OTHER), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
 		if (!bag_mode && topics_arg.isSet()) throw UsageError("--topics needs --bag");
+		if (bag_mode && topics_arg.getValue().size() != 2)
+			throw UsageError("--bag needs --topics REF_TOPIC OTHER_TOPIC (two topics)");
 
 		CScalingGridMapAligner aligner;
 		if (config_arg.isSet())
