@@ -57,7 +57,7 @@ FusedMap fuseGridMaps(
 		}
 	const double w = std::ceil((x1 - x0) / res), h = std::ceil((y1 - y0) / res);
 	if (w * h > static_cast<double>(max_cells))
-		throw std::invalid_argument(
+		throw MergedMapTooLarge(
 			"merged map would have " + std::to_string(static_cast<long long>(w * h)) +
 			" cells, more than the limit of " + std::to_string(max_cells));
 

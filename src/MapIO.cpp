@@ -64,6 +64,10 @@ COccupancyGridMap2D loadMapServerYaml(const std::string& path)
 {
 	std::ifstream in(path);
 	if (!in) fail(path, "cannot open");
+	const auto trim = [](const std::string& t) {
+		const size_t a = t.find_first_not_of(" \t\r\"'"), b = t.find_last_not_of(" \t\r\"'");
+		return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
+	};
 	std::map<std::string, std::string> kv;
 	std::string line;
 	for (int n = 0; std::getline(in, line); ++n)
@@ -71,12 +75,7 @@ COccupancyGridMap2D loadMapServerYaml(const std::string& path)
 		if (n > 1000 || line.size() > 4096) fail(path, "not a map_server YAML (too long)");
 		line = line.substr(0, line.find('#'));
 		const size_t colon = line.find(':');
-		if (colon == std::string::npos) continue;
-		auto trim = [](std::string t) {
-			const size_t a = t.find_first_not_of(" \t\r\"'"), b = t.find_last_not_of(" \t\r\"'");
-			return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
-		};
-		kv[trim(line.substr(0, colon))] = trim(line.substr(colon + 1));
+		if (colon != std::string::npos) kv[trim(line.substr(0, colon))] = trim(line.substr(colon + 1));
 	}
 	auto number = [&](const std::string& key, const std::string& text) {
 		try
@@ -99,11 +98,7 @@ COccupancyGridMap2D loadMapServerYaml(const std::string& path)
 		fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
 	std::vector<double> o;
 	std::stringstream items(origin.substr(1, origin.size() - 2));
-	for (std::string item; std::getline(items, item, ',');)
-	{
-		const size_t a = item.find_first_not_of(' '), b = item.find_last_not_of(' ');
-		o.push_back(number("origin", a == std::string::npos ? "" : item.substr(a, b - a + 1)));
-	}
+	for (std::string item; std::getline(items, item, ',');) o.push_back(number("origin", trim(item)));
 	if (o.size() < 2 || o.size() > 3) fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
 	if (o.size() == 3 && o[2] != 0) fail(path, "a rotated origin (yaw " + std::to_string(o[2]) + ") is not supported");
 	const bool negate = kv.count("negate") && number("negate", kv["negate"]) != 0;

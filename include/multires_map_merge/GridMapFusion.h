@@ -9,8 +9,16 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <opencv2/core.hpp>
 
+#include <stdexcept>
+
 namespace multires_map_merge
 {
+/** The merged map would exceed the caller's cell limit. */
+struct MergedMapTooLarge : std::invalid_argument
+{
+	using std::invalid_argument::invalid_argument;
+};
+
 struct FusedMap
 {
 	mrpt::maps::COccupancyGridMap2D merged;
@@ -24,8 +32,9 @@ struct FusedMap
  * TReturnInfo::metric does. Every output cell samples both maps at sub-cell
  * points (the other by the inverse transform), enough of them that no input
  * cell is skipped, so a one-cell wall survives a coarser output.
- * Throws std::invalid_argument on a non-positive or non-finite resolution,
- * an invalid transform, or an output of more than `max_cells` cells. */
+ * Throws std::invalid_argument on a non-positive or non-finite resolution or
+ * an invalid transform, MergedMapTooLarge (before allocating) on an output of
+ * more than `max_cells` cells. */
 FusedMap fuseGridMaps(
 	const mrpt::maps::COccupancyGridMap2D& ref, const mrpt::maps::COccupancyGridMap2D& other,
 	const Similarity2D& other_to_ref, double output_resolution,

@@ -14,26 +14,6 @@ MergeMapsService::MergeMapsService(const CScalingGridMapAligner::TConfigParams& 
 		throw std::invalid_argument("invalid aligner parameters: " + why);
 }
 
-namespace
-{
-/** The largest output the fusion may produce at `res`, in cells, estimated
- * from both maps' extents (other's by its corners under the transform). */
-double mergedCells(
-	const mrpt::maps::COccupancyGridMap2D& ref, const mrpt::maps::COccupancyGridMap2D& other,
-	const Similarity2D& other_to_ref, double res)
-{
-	double x0 = ref.getXMin(), x1 = ref.getXMax(), y0 = ref.getYMin(), y1 = ref.getYMax();
-	for (const double x : {other.getXMin(), other.getXMax()})
-		for (const double y : {other.getYMin(), other.getYMax()})
-		{
-			const Eigen::Vector2d c = other_to_ref.apply({x, y});
-			x0 = std::min(x0, c.x()), x1 = std::max(x1, c.x());
-			y0 = std::min(y0, c.y()), y1 = std::max(y1, c.y());
-		}
-	return std::ceil((x1 - x0) / res + 1) * std::ceil((y1 - y0) / res + 1);
-}
-}  // namespace
-
 void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response& res, Details* details) const
 {
 	const auto start = std::chrono::steady_clock::now();
@@ -72,21 +52,18 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 			res.implied_resolution_other = info.implied_resolution_other;
 
 			const double out_res = out_res_req > 0 ? out_res_req : ref.grid.getResolution();
-			const double cells = mergedCells(ref.grid, other.grid, info.metric, out_res);
-			if (cells > double(max_merged_cells))
-			{
-				std::ostringstream why;
-				why << "aligned, but the merged map would have " << cells << " cells at " << out_res
-					<< " m (limit " << max_merged_cells << "); ask for a coarser output_resolution";
-				res.message = why.str();
-			}
-			else
+			try
 			{
 				FusedMap fused = fuseGridMaps(ref.grid, other.grid, info.metric, out_res, max_merged_cells);
 				res.merged = msgFromGrid(fused.merged, ref.origin, req.reference.header);
 				if (details) details->fused = std::move(fused);
 				res.success = true;
 				res.message = "merged";
+			}
+			catch (const MergedMapTooLarge& e)
+			{
+				res.message = std::string("aligned, but the ") + e.what() + " at " + std::to_string(out_res) +
+							  " m; ask for a coarser output_resolution";
 			}
 		}
 	}
