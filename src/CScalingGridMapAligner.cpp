@@ -273,6 +273,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	return info;
 }
 
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
+	const GridInFrame& ref, const GridInFrame& other) const
+{
+	TReturnInfo info = alignScaled(ref.grid, other.grid);
+	info.metric = betweenMapFrames(ref, info.metric, other);
+	return info;
+}
+
 mrpt::poses::CPosePDF::Ptr CScalingGridMapAligner::AlignPDF(
 	const mrpt::maps::CMetricMap* m1, const mrpt::maps::CMetricMap* m2,
 	const mrpt::poses::CPosePDFGaussian&,

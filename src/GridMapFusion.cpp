@@ -62,7 +62,7 @@ FusedMap fuseGridMaps(
 			" cells, more than the limit of " + std::to_string(max_cells));
 
 	FusedMap fused;
-	COccupancyGridMap2D& out = fused.merged;
+	COccupancyGridMap2D& out = fused.merged.grid;
 	out.setSize(
 		static_cast<float>(x0), static_cast<float>(x0 + w * res), static_cast<float>(y0),
 		static_cast<float>(y0 + h * res), static_cast<float>(res), 0.5f);
@@ -94,6 +94,15 @@ FusedMap fuseGridMaps(
 			fused.ref_classes.at<uint8_t>(cy, cx) = classify(a);
 			fused.other_classes.at<uint8_t>(cy, cx) = classify(b);
 		}
+	return fused;
+}
+
+FusedMap fuseGridMaps(
+	const GridInFrame& ref, const GridInFrame& other, const Similarity2D& other_to_ref, double res,
+	size_t max_cells)
+{
+	FusedMap fused = fuseGridMaps(ref.grid, other.grid, betweenGrids(ref, other_to_ref, other), res, max_cells);
+	fused.merged.origin = ref.origin;
 	return fused;
 }
 

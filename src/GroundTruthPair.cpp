@@ -118,6 +118,15 @@ COccupancyGridMap2D renderGrid(
 	return grid;
 }
 
+GridInFrame renderGridOffLattice(
+	const ScanSequence& scans, size_t begin, size_t end, double resolution, const mrpt::poses::CPose2D& frame,
+	double dx, double dy, float max_range)
+{
+	// A point p of the shifted frame is p + (dx, dy) in `frame`.
+	return {renderGrid(scans, begin, end, resolution, frame + mrpt::poses::CPose2D(dx, dy, 0), max_range),
+			Similarity2D(1, 0, {dx, dy})};
+}
+
 GroundTruthPair makeGroundTruthPair(const ScanSequence& scans, const PairSpec& spec)
 {
 	const size_t n = scans.size();

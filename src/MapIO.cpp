@@ -6,6 +6,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/serialization/CArchive.h>
 #include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <filesystem>
@@ -57,90 +58,175 @@ COccupancyGridMap2D loadSerialized(const std::string& path)
 	return g;
 }
 
-/** The map_server YAML keys, read line by line: the format is flat, and a
- * general YAML parser (MRPT's libfyaml) hangs on some corrupt files (found
- * by fuzzing). */
-COccupancyGridMap2D loadMapServerYaml(const std::string& path)
+/** How map_server turns pixels into occupancy (ROS 1 Noetic map_server). */
+enum class MapServerMode
 {
-	std::ifstream in(path);
-	if (!in) fail(path, "cannot open");
-	const auto trim = [](const std::string& t) {
-		const size_t a = t.find_first_not_of(" \t\r\"'"), b = t.find_last_not_of(" \t\r\"'");
-		return a == std::string::npos ? std::string() : t.substr(a, b - a + 1);
-	};
-	std::map<std::string, std::string> kv;
-	std::string line;
-	for (int n = 0; std::getline(in, line); ++n)
+	trinary,
+	scale,
+	raw
+};
+
+struct MapServerYaml
+{
+	std::filesystem::path image;
+	double resolution = 0;
+	double origin[3] = {0, 0, 0};
+	bool negate = false;
+	double occupied_thresh = 0.65, free_thresh = 0.196;
+	MapServerMode mode = MapServerMode::trinary;
+};
+
+// A map_server YAML is a few hundred bytes; the limit keeps the parser away
+// from anything that is not one.
+constexpr std::uintmax_t kMaxYamlBytes = 64 * 1024;
+
+MapServerYaml readMapServerYaml(const std::string& path)
+{
+	if (std::filesystem::file_size(path) > kMaxYamlBytes)
+		fail(path, "not a map_server YAML (larger than " + std::to_string(kMaxYamlBytes / 1024) + " KiB)");
+	YAML::Node doc;
+	try
 	{
-		if (n > 1000 || line.size() > 4096) fail(path, "not a map_server YAML (too long)");
-		line = line.substr(0, line.find('#'));
-		const size_t colon = line.find(':');
-		if (colon != std::string::npos) kv[trim(line.substr(0, colon))] = trim(line.substr(colon + 1));
+		doc = YAML::LoadFile(path);
 	}
-	auto number = [&](const std::string& key, const std::string& text) {
+	catch (const YAML::Exception& e)
+	{
+		fail(path, "not a map_server YAML (" + e.msg + " at line " + std::to_string(e.mark.line + 1) + ")");
+	}
+	if (!doc.IsMap()) fail(path, "not a map_server YAML (expected keys image, resolution, origin, ...)");
+	auto scalar = [&](const char* key) -> const YAML::Node {
+		const YAML::Node n = doc[key];
+		if (!n.IsScalar()) fail(path, std::string("'") + key + "' must be a single value");
+		return n;
+	};
+	auto number = [&](const char* key, const YAML::Node& n) {
+		double v = NAN;
 		try
 		{
-			size_t used = 0;
-			const double v = std::stod(text, &used);
-			if (used == text.size() && std::isfinite(v)) return v;
+			v = n.as<double>();
 		}
-		catch (const std::exception&)
+		catch (const YAML::Exception&)
 		{
 		}
-		fail(path, key + " must be a finite number, not '" + text + "'");
+		if (!std::isfinite(v))
+			fail(path, std::string("'") + key + "' must be a finite number, not '" + (n.IsScalar() ? n.Scalar() : "a list") + "'");
+		return v;
 	};
 	for (const char* key : {"image", "resolution", "origin"})
-		if (!kv.count(key)) fail(path, std::string("unreadable map_server YAML: no '") + key + "'");
-	const double res = number("resolution", kv["resolution"]);
-	if (!(res > 0)) fail(path, "invalid resolution " + kv["resolution"]);
-	std::string origin = kv["origin"];
-	if (origin.size() < 2 || origin.front() != '[' || origin.back() != ']')
-		fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
-	std::vector<double> o;
-	std::stringstream items(origin.substr(1, origin.size() - 2));
-	for (std::string item; std::getline(items, item, ',');) o.push_back(number("origin", trim(item)));
-	if (o.size() < 2 || o.size() > 3) fail(path, "origin must be [x, y, yaw], not '" + origin + "'");
-	if (o.size() == 3 && o[2] != 0) fail(path, "a rotated origin (yaw " + std::to_string(o[2]) + ") is not supported");
-	const bool negate = kv.count("negate") && number("negate", kv["negate"]) != 0;
-	const double occ_th = kv.count("occupied_thresh") ? number("occupied_thresh", kv["occupied_thresh"]) : 0.65;
-	const double free_th = kv.count("free_thresh") ? number("free_thresh", kv["free_thresh"]) : 0.196;
+		if (!doc[key]) fail(path, std::string("unreadable map_server YAML: no '") + key + "'");
 
-	std::filesystem::path image(kv["image"]);
-	if (image.is_relative()) image = std::filesystem::path(path).parent_path() / image;
-	if (!std::filesystem::is_regular_file(image)) fail(path, "unreadable map_server YAML or image (no image '" + image.string() + "')");
+	MapServerYaml y;
+	y.image = scalar("image").Scalar();
+	if (y.image.empty()) fail(path, "'image' is empty");
+	if (y.image.is_relative()) y.image = std::filesystem::path(path).parent_path() / y.image;
+	y.resolution = number("resolution", scalar("resolution"));
+	if (!(y.resolution > 0)) fail(path, "'resolution' must be > 0, not " + doc["resolution"].Scalar());
+	const YAML::Node origin = doc["origin"];
+	if (!origin.IsSequence() || origin.size() < 2 || origin.size() > 3)
+		fail(path, "'origin' must be [x, y, yaw]");
+	for (size_t i = 0; i < origin.size(); ++i) y.origin[i] = number("origin", origin[i]);
+	// Absent keys take map_server's documented defaults (ROS 1 map_server
+	// itself refuses such a file; nothing is gained by refusing it here).
+	if (doc["negate"])
+	{
+		const YAML::Node n = scalar("negate");
+		bool b = false;
+		if (YAML::convert<bool>::decode(n, b))
+			y.negate = b;
+		else
+			y.negate = number("negate", n) != 0;
+	}
+	if (doc["occupied_thresh"]) y.occupied_thresh = number("occupied_thresh", scalar("occupied_thresh"));
+	if (doc["free_thresh"]) y.free_thresh = number("free_thresh", scalar("free_thresh"));
+	for (const auto& [key, v] : {std::pair{"occupied_thresh", y.occupied_thresh}, std::pair{"free_thresh", y.free_thresh}})
+		if (v < 0 || v > 1) fail(path, std::string("'") + key + "' must be in [0, 1], not " + std::to_string(v));
+	if (doc["mode"])
+	{
+		const std::string mode = scalar("mode").Scalar();
+		if (mode == "trinary") y.mode = MapServerMode::trinary;
+		else if (mode == "scale") y.mode = MapServerMode::scale;
+		else if (mode == "raw") y.mode = MapServerMode::raw;
+		else fail(path, "'mode' must be trinary, scale or raw, not '" + mode + "'");
+	}
+	if (y.mode == MapServerMode::scale && !(y.occupied_thresh > y.free_thresh))
+		fail(path, "'mode: scale' needs occupied_thresh > free_thresh");
+	return y;
+}
+
+/** Occupancy in 0..100, or -1 for unknown, of one pixel: map_server's rules.
+ * `colour` is the channel mean (alpha included in trinary mode, as
+ * map_server does), `opaque` false for a fully transparent pixel. */
+int mapServerValue(double colour, bool opaque, const MapServerYaml& y)
+{
+	if (y.negate) colour = 255 - colour;
+	if (y.mode == MapServerMode::raw)
+	{
+		// map_server copies the byte into an int8: 0..100 are occupancies,
+		// 255 reads as -1 (unknown); anything else is no occupancy at all.
+		const int v = static_cast<int>(colour);
+		return v <= 100 ? v : -1;
+	}
+	const double occ = (255 - colour) / 255.0;
+	if (occ > y.occupied_thresh) return 100;
+	if (occ < y.free_thresh) return 0;
+	if (y.mode == MapServerMode::trinary || !opaque) return -1;
+	return static_cast<int>(99 * (occ - y.free_thresh) / (y.occupied_thresh - y.free_thresh));
+}
+
+GridInFrame loadMapServerYaml(const std::string& path)
+{
+	const MapServerYaml y = readMapServerYaml(path);
+	if (!std::filesystem::is_regular_file(y.image))
+		fail(path, "unreadable map_server YAML or image (no image '" + y.image.string() + "')");
 	cv::Mat img;
 	try
 	{
-		img = cv::imread(image.string(), cv::IMREAD_GRAYSCALE);
+		img = cv::imread(y.image.string(), cv::IMREAD_UNCHANGED);
 	}
 	catch (const cv::Exception& e)
 	{
 		fail(path, "unreadable map_server YAML or image (" + std::string(e.what()) + ")");
 	}
-	if (img.empty()) fail(path, "unreadable map_server YAML or image ('" + image.string() + "' is not an image)");
-	// map_server's trinary rule; images have +y up, grids row = cy.
-	const cv::Mat rows = forDisplay(img);
-	COccupancyGridMap2D g(
-		float(o[0]), float(o[0] + rows.cols * res), float(o[1]), float(o[1] + rows.rows * res), float(res));
-	for (int cy = 0; cy < rows.rows && cy < int(g.getSizeY()); ++cy)
-		for (int cx = 0; cx < rows.cols && cx < int(g.getSizeX()); ++cx)
+	if (img.empty()) fail(path, "unreadable map_server YAML or image ('" + y.image.string() + "' is not an image)");
+	if (img.depth() == CV_16U) img.convertTo(img, CV_8U, 1.0 / 257);  // as SDL_image reads 16-bit PNGs
+	if (img.depth() != CV_8U || img.channels() > 4)
+		fail(path, "image '" + y.image.string() + "' is not an 8- or 16-bit grey or colour image");
+	const int channels = img.channels();
+	const bool has_alpha = channels == 2 || channels == 4;
+	// map_server averages alpha in with the colour in trinary mode only.
+	const int averaged = (has_alpha && y.mode != MapServerMode::trinary) ? channels - 1 : channels;
+
+	GridInFrame map;
+	map.origin = Similarity2D(1, y.origin[2], {y.origin[0], y.origin[1]});
+	COccupancyGridMap2D& g = map.grid;
+	g.setSize(0, float(img.cols * y.resolution), 0, float(img.rows * y.resolution), float(y.resolution), 0.5f);
+	if (int(g.getSizeX()) != img.cols || int(g.getSizeY()) != img.rows)
+		fail(path, "resolution " + std::to_string(y.resolution) + " is too extreme for a " +
+					   std::to_string(img.cols) + "x" + std::to_string(img.rows) + " image");
+	for (int row = 0; row < img.rows; ++row)
+	{
+		const uint8_t* px = img.ptr<uint8_t>(row);
+		const int cy = img.rows - 1 - row;  // image rows run top-down, grid rows bottom-up
+		for (int cx = 0; cx < img.cols; ++cx, px += channels)
 		{
-			const double v = rows.at<uint8_t>(cy, cx) / 255.0;
-			const double p_occ = negate ? v : 1 - v;
-			g.setCell(cx, cy, p_occ > occ_th ? 0.0f : (p_occ < free_th ? 1.0f : 0.5f));
+			int sum = 0;
+			for (int k = 0; k < averaged; ++k) sum += px[k];
+			const int v = mapServerValue(double(sum) / averaged, !has_alpha || px[channels - 1] > 0, y);
+			g.setCell(cx, cy, v < 0 ? 0.5f : 1.0f - v / 100.0f);  // MRPT stores P(free)
 		}
-	return g;
+	}
+	return map;
 }
 }  // namespace
 
-COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolution)
+GridInFrame loadGridMap(const std::string& path, double simplemap_resolution)
 {
 	if (!std::filesystem::is_regular_file(path)) fail(path, "no such file");
-	COccupancyGridMap2D g;
+	GridInFrame map;
 	if (hasSuffix(path, ".gridmap") || hasSuffix(path, ".gridmap.gz"))
-		g = loadSerialized(path);
+		map.grid = loadSerialized(path);
 	else if (hasSuffix(path, ".yaml") || hasSuffix(path, ".yml"))
-		g = loadMapServerYaml(path);
+		map = loadMapServerYaml(path);
 	else if (hasSuffix(path, ".simplemap") || hasSuffix(path, ".simplemap.gz"))
 	{
 		if (!std::isfinite(simplemap_resolution) || !(simplemap_resolution > 0))
@@ -148,7 +234,7 @@ COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolu
 		try
 		{
 			const ScanSequence scans = loadSimplemapScans(path);
-			g = renderGrid(scans, 0, scans.size(), simplemap_resolution);
+			map.grid = renderGrid(scans, 0, scans.size(), simplemap_resolution);
 		}
 		catch (const std::exception& e)
 		{
@@ -157,22 +243,46 @@ COccupancyGridMap2D loadGridMap(const std::string& path, double simplemap_resolu
 	}
 	else
 		fail(path, "unknown map format (expected .gridmap[.gz], .yaml or .simplemap[.gz])");
-	checkLoaded(g, path);
-	return g;
+	checkLoaded(map.grid, path);
+	return map;
 }
 
-void saveGridMap(const COccupancyGridMap2D& grid, const std::string& path, const Similarity2D& frame)
+std::string saveGridMap(const GridInFrame& map, const std::string& path)
 {
-	const bool identity = frame.scale == 1 && frame.yaw == 0 && frame.t.isZero();
+	const COccupancyGridMap2D& grid = map.grid;
 	if (hasSuffix(path, ".gridmap") || hasSuffix(path, ".gridmap.gz"))
 	{
-		// MRPT snaps a grid's corner to whole cells: an arbitrary frame would shift it.
-		if (!identity) fail(path, "a .gridmap cannot hold the map's origin pose exactly; save as .yaml");
-		mrpt::io::CFileGZOutputStream out;
-		if (!out.open(path, hasSuffix(path, ".gz") ? 6 : 0)) fail(path, "cannot write");
-		auto arch = mrpt::serialization::archiveFrom(out);
-		arch << grid;
-		return;
+		std::string note;
+		const COccupancyGridMap2D* out = &grid;
+		COccupancyGridMap2D moved;
+		if (!map.originIsIdentity())
+		{
+			if (map.origin.yaw != 0)
+				fail(path, "a .gridmap cannot hold a rotated map origin; save as .yaml");
+			// MRPT snaps the corner to a multiple of the cell size.
+			const Eigen::Vector2d corner = map.cornerInMapFrame();
+			const double r = grid.getResolution();
+			moved.setSize(
+				float(corner.x()), float(corner.x() + grid.getSizeX() * r), float(corner.y()),
+				float(corner.y() + grid.getSizeY() * r), float(r), 0.5f);
+			const unsigned w = std::min(moved.getSizeX(), grid.getSizeX()), h = std::min(moved.getSizeY(), grid.getSizeY());
+			for (unsigned cy = 0; cy < h; ++cy)
+				for (unsigned cx = 0; cx < w; ++cx) moved.setCell(cx, cy, grid.getCell(cx, cy));
+			const Eigen::Vector2d shift = Eigen::Vector2d(moved.getXMin(), moved.getYMin()) - corner;
+			if (shift.norm() > 1e-9)
+			{
+				std::ostringstream s;
+				s << "a .gridmap keeps its corner on a multiple of the cell size: the map in '" << path
+				  << "' is shifted by (" << shift.x() << ", " << shift.y() << ") m; a .yaml holds it exactly";
+				note = s.str();
+			}
+			out = &moved;
+		}
+		mrpt::io::CFileGZOutputStream stream;
+		if (!stream.open(path, hasSuffix(path, ".gz") ? 6 : 0)) fail(path, "cannot write");
+		auto arch = mrpt::serialization::archiveFrom(stream);
+		arch << *out;
+		return note;
 	}
 	if (hasSuffix(path, ".yaml") || hasSuffix(path, ".yml"))
 	{
@@ -183,17 +293,22 @@ void saveGridMap(const COccupancyGridMap2D& grid, const std::string& path, const
 		img.setTo(205, img == kUnknown);
 		// map_server images have +y up: the first row is the top of the map.
 		if (!cv::imwrite(pgm.string(), forDisplay(img))) fail(pgm.string(), "cannot write");
-		const Eigen::Vector2d corner = frame.apply({grid.getXMin(), grid.getYMin()});
+		const Eigen::Vector2d corner = map.cornerInMapFrame();
 		std::ofstream y(path);
-		y.precision(12);
+		y.precision(17);  // the origin round-trips exactly
 		y << "image: " << pgm.filename().string() << "\n"
 		  << "resolution: " << grid.getResolution() << "\n"
-		  << "origin: [" << corner.x() << ", " << corner.y() << ", " << frame.yaw << "]\n"
+		  << "origin: [" << corner.x() << ", " << corner.y() << ", " << map.origin.yaw << "]\n"
 		  << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
 		if (!y) fail(path, "cannot write");
-		return;
+		return "";
 	}
 	fail(path, "unknown output format (expected .gridmap[.gz] or .yaml)");
+}
+
+std::string saveGridMap(const COccupancyGridMap2D& grid, const std::string& path)
+{
+	return saveGridMap(GridInFrame{grid, Similarity2D()}, path);
 }
 
 }  // namespace multires_map_merge

@@ -1,62 +1,45 @@
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/MergeReport.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
-#include <iomanip>
-#include <sstream>
 
 namespace multires_map_merge
 {
 namespace
 {
-std::string quoted(const std::string& s)
+// JSON has no NaN or infinity: null says "no value".
+nlohmann::ordered_json num(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); }
+
+nlohmann::ordered_json transformJson(const Similarity2D& t)
 {
-	std::ostringstream o;
-	o << '"';
-	for (const unsigned char c : s)
-	{
-		if (c == '"' || c == '\\') o << '\\' << c;
-		else if (c < 0x20) o << "\\u" << std::hex << std::setw(4) << std::setfill('0') << int(c) << std::dec;
-		else o << c;
-	}
-	o << '"';
-	return o.str();
-}
-// JSON has no NaN or infinity.
-std::string num(double v)
-{
-	if (!std::isfinite(v)) return "null";
-	std::ostringstream o;
-	o << std::setprecision(10) << v;
-	return o.str();
+	return {{"x", num(t.t.x())}, {"y", num(t.t.y())}, {"yaw", num(t.yaw)}, {"scale", num(t.scale)}};
 }
 }  // namespace
 
 std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_s)
 {
-	std::ostringstream j;
-	j << "{\n  \"success\": " << (r.success ? "true" : "false") << ",\n";
-	j << "  \"transform\": {\"x\": " << num(r.metric.t.x()) << ", \"y\": " << num(r.metric.t.y())
-	  << ", \"yaw\": " << num(r.metric.yaw) << ", \"scale\": " << num(r.metric.scale) << "},\n";
-	j << "  \"scale_cells\": " << num(r.cells.scale) << ",\n";
-	j << "  \"implied_resolution_other\": " << num(r.implied_resolution_other) << ",\n";
-	j << "  \"initial_transform_cells\": {\"x\": " << num(r.initial_cells.t.x()) << ", \"y\": "
-	  << num(r.initial_cells.t.y()) << ", \"yaw\": " << num(r.initial_cells.yaw)
-	  << ", \"scale\": " << num(r.initial_cells.scale) << "},\n";
-	j << "  \"overlap\": " << num(r.overlap) << ",\n";
-	j << "  \"objective\": " << num(r.objective) << ",\n";
-	j << "  \"inliers\": " << r.ransac_inliers << ",\n";
-	j << "  \"consistency\": " << num(r.consistency) << ",\n";
-	j << "  \"confidence\": " << num(r.confidence) << ",\n";
-	j << "  \"icp_iterations\": " << r.icp_iterations << ",\n";
-	j << "  \"runtime_s\": " << num(runtime_s) << ",\n";
-	j << "  \"stages\": {";
-	bool first = true;
-	for (const auto& [name, secs] : r.stage_seconds)
-		j << (first ? "" : ", ") << quoted(name) << ": " << num(secs), first = false;
-	j << "},\n";
-	j << "  \"error\": " << quoted(r.success ? "" : r.message) << "\n}\n";
-	return j.str();
+	nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+	for (const auto& [name, secs] : r.stage_seconds) stages[name] = num(secs);
+	const nlohmann::ordered_json j = {
+		{"success", r.success},
+		{"transform", transformJson(r.metric)},
+		{"scale_cells", num(r.cells.scale)},
+		{"implied_resolution_other", num(r.implied_resolution_other)},
+		{"initial_transform_cells", transformJson(r.initial_cells)},
+		{"overlap", num(r.overlap)},
+		{"objective", num(r.objective)},
+		{"inliers", r.ransac_inliers},
+		{"consistency", num(r.consistency)},
+		{"confidence", num(r.confidence)},
+		{"icp_iterations", r.icp_iterations},
+		{"runtime_s", num(runtime_s)},
+		{"stages", stages},
+		{"error", r.success ? "" : r.message},
+	};
+	// Invalid UTF-8 (a file name, say) is replaced rather than thrown on.
+	return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 cv::Mat overlayImage(const cv::Mat& ref, const cv::Mat& other)

@@ -52,8 +52,8 @@ inline MsgPair msgPair(const PairSpec& spec, const Similarity2D& ref_origin, con
 	std_msgs::Header h1, h2;
 	h1.frame_id = "robot1/map";
 	h2.frame_id = "robot2/map";
-	p.ref = ros1::msgFromGrid(p.grids.ref, ref_origin, h1);
-	p.other = ros1::msgFromGrid(p.grids.other, other_origin, h2);
+	p.ref = ros1::msgFromGrid({p.grids.ref, ref_origin}, h1);
+	p.other = ros1::msgFromGrid({p.grids.other, other_origin}, h2);
 	p.truth = ref_origin.compose(p.grids.other_to_ref).compose(other_origin.inverse());
 	return p;
 }
@@ -198,15 +198,15 @@ inline std::vector<BadRequest> badRequests()
 		const auto& loc = scansOf(mrptDataset("localization_demo.simplemap.gz"));
 		std_msgs::Header h;
 		h.frame_id = "robot3/map";
-		return ros1::msgFromGrid(renderGrid(loc, 0, loc.size(), 0.08), rigid(0, 0, 0), h);
+		return ros1::msgFromGrid({renderGrid(loc, 0, loc.size(), 0.08), rigid(0, 0, 0)}, h);
 	}();
 	// Two ends of one building, 5 and 8 cm, sharing no cell.
 	static const std::pair<nav_msgs::OccupancyGrid, nav_msgs::OccupancyGrid> disjoint = [] {
 		const auto& s = malagaScans();
 		std_msgs::Header h;
 		h.frame_id = "robot4/map";
-		const auto a = ros1::msgFromGrid(renderGrid(s, 0, s.size(), 0.05), rigid(0, 0, 0), h);
-		const auto b = ros1::msgFromGrid(renderGrid(s, 0, s.size(), 0.08), rigid(0, 0, 0), h);
+		const auto a = ros1::msgFromGrid({renderGrid(s, 0, s.size(), 0.05), rigid(0, 0, 0)}, h);
+		const auto b = ros1::msgFromGrid({renderGrid(s, 0, s.size(), 0.08), rigid(0, 0, 0)}, h);
 		return std::pair{cropColumns(a, 0, a.info.width * 2 / 5), cropColumns(b, b.info.width * 3 / 5, b.info.width)};
 	}();
 	return {

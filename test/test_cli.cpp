@@ -71,7 +71,7 @@ TEST(Cli, GridmapInputsAllOutputsAndJsonAgainstTruth)
 	ASSERT_EQ(r.exit_code, 0) << r.output;
 	EXPECT_NE(r.output.find("implied resolution"), std::string::npos) << r.output;
 	expectTransformMatchesTruth(slurp(d + "/a.json"));
-	const auto merged = loadGridMap(d + "/merged.gridmap.gz");
+	const auto merged = loadGridMap(d + "/merged.gridmap.gz").grid;
 	EXPECT_NEAR(merged.getResolution(), 0.05, 1e-6);  // the reference's by default
 	// The union contains the reference map.
 	EXPECT_LE(merged.getXMin(), malagaPair().ref.getXMin() + 1e-3);
@@ -92,13 +92,13 @@ TEST(Cli, MapServerYamlInAndOutWithFinestResolution)
 		"/merged.yaml --output-resolution finest");
 	ASSERT_EQ(r.exit_code, 0) << r.output;
 	expectTransformMatchesTruth(slurp(d + "/b.json"));
-	const auto merged = loadGridMap(d + "/merged.yaml");
+	const auto merged = loadGridMap(d + "/merged.yaml").grid;
 	EXPECT_NEAR(merged.getResolution(), 0.05, 1e-4);
 	EXPECT_TRUE(fs::exists(d + "/merged.pgm"));
 	// An explicit output resolution.
 	const CliRun r2 = runCli(d + "/ref.yaml " + d + "/other.yaml --out " + d + "/m10.gridmap.gz --output-resolution 0.1");
 	ASSERT_EQ(r2.exit_code, 0) << r2.output;
-	EXPECT_NEAR(loadGridMap(d + "/m10.gridmap.gz").getResolution(), 0.1, 1e-6);
+	EXPECT_NEAR(loadGridMap(d + "/m10.gridmap.gz").grid.getResolution(), 0.1, 1e-6);
 }
 
 TEST(Cli, SimplemapInputsRenderedAtTheGivenResolution)

@@ -51,14 +51,14 @@ TEST(Fusion, UnionOfExtentsInTheReferenceFrame)
 	setOcc(other, 0.52, 0.52, 0.9f);  // occupied in other's own frame
 	// other's frame sits 2 m along x in ref's frame.
 	const FusedMap f = fuseGridMaps(ref, other, Similarity2D(1, 0, {2, 0}), 0.1);
-	EXPECT_NEAR(f.merged.getXMin(), 0.0, 1e-6);
-	EXPECT_NEAR(f.merged.getXMax(), 3.0, 1e-6);
-	EXPECT_NEAR(f.merged.getYMax(), 1.0, 1e-6);
-	EXPECT_EQ(f.merged.getSizeX(), 30u);
-	EXPECT_EQ(f.merged.getSizeY(), 10u);
-	EXPECT_EQ(classify(occAt(f.merged, 0.55, 0.55)), kFree);
-	EXPECT_EQ(classify(occAt(f.merged, 2.52, 0.52)), kOccupied);
-	EXPECT_EQ(classify(occAt(f.merged, 1.5, 0.5)), kUnknown);  // between the maps
+	EXPECT_NEAR(f.merged.grid.getXMin(), 0.0, 1e-6);
+	EXPECT_NEAR(f.merged.grid.getXMax(), 3.0, 1e-6);
+	EXPECT_NEAR(f.merged.grid.getYMax(), 1.0, 1e-6);
+	EXPECT_EQ(f.merged.grid.getSizeX(), 30u);
+	EXPECT_EQ(f.merged.grid.getSizeY(), 10u);
+	EXPECT_EQ(classify(occAt(f.merged.grid, 0.55, 0.55)), kFree);
+	EXPECT_EQ(classify(occAt(f.merged.grid, 2.52, 0.52)), kOccupied);
+	EXPECT_EQ(classify(occAt(f.merged.grid, 1.5, 0.5)), kUnknown);  // between the maps
 	EXPECT_EQ(f.ref_classes.size(), cv::Size(30, 10));
 }
 
@@ -72,9 +72,9 @@ TEST(Fusion, RotationScaleAndOriginsHonoured)
 	const Similarity2D t(2.0, M_PI / 2, {1, 1});
 	const Eigen::Vector2d where = t(Eigen::Vector2d(-2.475, 4.475));
 	const FusedMap f = fuseGridMaps(ref, other, t, 0.1);
-	EXPECT_EQ(classify(occAt(f.merged, where.x(), where.y())), kOccupied);
-	EXPECT_LE(f.merged.getXMin(), where.x());
-	EXPECT_GE(f.merged.getYMax(), where.y());
+	EXPECT_EQ(classify(occAt(f.merged.grid, where.x(), where.y())), kOccupied);
+	EXPECT_LE(f.merged.grid.getXMin(), where.x());
+	EXPECT_GE(f.merged.grid.getYMax(), where.y());
 }
 
 TEST(Fusion, AOneCellWallSurvivesACoarserOutput)
@@ -83,8 +83,8 @@ TEST(Fusion, AOneCellWallSurvivesACoarserOutput)
 	for (double x = 0.01; x < 2; x += 0.02)
 		for (double y = 0.01; y < 2; y += 0.02) setOcc(other, x, y, std::abs(y - 1.01) < 0.005 ? 0.9f : 0.1f);
 	const FusedMap f = fuseGridMaps(ref, other, Similarity2D(), 0.1);
-	for (double x = 0.05; x < 2; x += 0.1) EXPECT_EQ(classify(occAt(f.merged, x, 1.01)), kOccupied) << x;
-	EXPECT_EQ(classify(occAt(f.merged, 1.0, 0.5)), kFree);
+	for (double x = 0.05; x < 2; x += 0.1) EXPECT_EQ(classify(occAt(f.merged.grid, x, 1.01)), kOccupied) << x;
+	EXPECT_EQ(classify(occAt(f.merged.grid, 1.0, 0.5)), kFree);
 }
 
 TEST(Fusion, RefusesAbsurdSizesAndBadArguments)
@@ -105,12 +105,14 @@ TEST(MapIO, EveryOutputFormatRoundTripsOnARealMap)
 	{
 		SCOPED_TRACE(name);
 		saveGridMap(g, tmp(name));
-		const COccupancyGridMap2D back = loadGridMap(tmp(name));
+		const GridInFrame loaded = loadGridMap(tmp(name));
+		const COccupancyGridMap2D& back = loaded.grid;
 		ASSERT_EQ(back.getSizeX(), g.getSizeX());
 		ASSERT_EQ(back.getSizeY(), g.getSizeY());
 		EXPECT_NEAR(back.getResolution(), g.getResolution(), 1e-6);
-		EXPECT_NEAR(back.getXMin(), g.getXMin(), 1e-3);
-		EXPECT_NEAR(back.getYMin(), g.getYMin(), 1e-3);
+		// The map's corner where it was (a .yaml holds it in the origin).
+		EXPECT_NEAR(loaded.cornerInMapFrame().x(), g.getXMin(), 1e-6);
+		EXPECT_NEAR(loaded.cornerInMapFrame().y(), g.getYMin(), 1e-6);
 		EXPECT_EQ(cv::countNonZero(toClassImage(back) != classes), 0);  // not mirrored
 	}
 }
@@ -144,7 +146,7 @@ TEST(MapIO, BadFilesGiveErrorsNamingTheFile)
 TEST(MapIO, ReadsTheRealWillowMapServerFiles)
 {
 	MMM_REQUIRE_SHARED(yaml, "ros_maps/willow/navstage_willow_10cm.yaml");
-	const COccupancyGridMap2D g = loadGridMap(yaml);
+	const COccupancyGridMap2D g = loadGridMap(yaml).grid;
 	EXPECT_EQ(g.getSizeX(), 584u);
 	EXPECT_EQ(g.getSizeY(), 526u);
 	EXPECT_NEAR(g.getResolution(), 0.1, 1e-6);

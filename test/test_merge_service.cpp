@@ -19,11 +19,11 @@ TEST(OccupancyGridConversion, RoundTripKeepsCellsAndOrigin)
 	std_msgs::Header h;
 	h.frame_id = "map";
 	const Similarity2D origin = rigid(12.5, -3.25, 2.5);
-	const auto msg = ros1::msgFromGrid(grid, origin, h);
+	const auto msg = ros1::msgFromGrid({grid, origin}, h);
 	EXPECT_EQ(msg.header.frame_id, "map");
 	ASSERT_EQ(msg.info.width, grid.getSizeX());
 	ASSERT_EQ(msg.info.height, grid.getSizeY());
-	const ros1::GridInFrame back = ros1::gridFromMsg(msg);
+	const GridInFrame back = ros1::gridFromMsg(msg);
 	ASSERT_EQ(back.grid.getSizeX(), grid.getSizeX());
 	ASSERT_EQ(back.grid.getSizeY(), grid.getSizeY());
 	EXPECT_NEAR(back.grid.getResolution(), 0.07, 1e-6);
@@ -64,7 +64,7 @@ TEST(MergeMapsService, RotatedOriginsGiveTheTruthBetweenFrames)
 	EXPECT_EQ(res.message, "merged");
 	EXPECT_TRUE(details.info.success);
 	ASSERT_TRUE(details.fused.has_value());
-	EXPECT_EQ(details.fused->merged.getSizeX(), res.merged.info.width);
+	EXPECT_EQ(details.fused->merged.grid.getSizeX(), res.merged.info.width);
 }
 
 TEST(MergeMapsService, OutputResolutionAndSizeLimit)

@@ -11,6 +11,7 @@
 // the scale between the maps' cells is estimated.
 
 #include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/Similarity2D.h>
 #include <multires_map_merge/TsICP.h>
 
@@ -102,6 +103,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	TReturnInfo alignScaled(
 		const mrpt::maps::COccupancyGridMap2D& ref,
 		const mrpt::maps::COccupancyGridMap2D& other) const;
+
+	/** The same for maps held in their exact frames (map_server files, ROS
+	 * messages; MapIO, OccupancyGridConversion): TReturnInfo::metric is then
+	 * between the *maps'* frames (x_ref_map = metric(x_other_map)), exact for
+	 * any origin; `cells` is unchanged. */
+	TReturnInfo alignScaled(const GridInFrame& ref, const GridInFrame& other) const;
 
 	/** MRPT interface. m1 = reference, m2 = other, both COccupancyGridMap2D.
 	 * The initial estimate is not needed (the search is global) and ignored.

@@ -4,6 +4,7 @@
 // occupied if either map is occupied there, else free if either is free,
 // else unknown; within a class the stronger evidence is kept.
 
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/Similarity2D.h>
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -21,7 +22,9 @@ struct MergedMapTooLarge : std::invalid_argument
 
 struct FusedMap
 {
-	mrpt::maps::COccupancyGridMap2D merged;
+	/** In the reference grid's frame; `merged.origin` places it in the
+	 * reference map's frame (identity for the grid overload). */
+	GridInFrame merged;
 	/** Each input as sampled on the merged grid (class images, row = cy):
 	 * what the overlay PNG shows. */
 	cv::Mat ref_classes, other_classes;
@@ -39,6 +42,14 @@ FusedMap fuseGridMaps(
 	const mrpt::maps::COccupancyGridMap2D& ref, const mrpt::maps::COccupancyGridMap2D& other,
 	const Similarity2D& other_to_ref, double output_resolution,
 	size_t max_cells = size_t(1) << 28);
+
+/** The same for maps in their frames: `other_to_ref` is between the maps'
+ * frames (the GridInFrame overload of CScalingGridMapAligner::alignScaled);
+ * the merged grid lies on the reference grid's cell lattice (at the
+ * reference's resolution) and its origin is the reference's. */
+FusedMap fuseGridMaps(
+	const GridInFrame& ref, const GridInFrame& other, const Similarity2D& other_to_ref,
+	double output_resolution, size_t max_cells = size_t(1) << 28);
 
 /** The cell rule on two occupancy probabilities (0.5 = unknown). */
 float fuseCell(float p_ref, float p_other);

@@ -5,6 +5,7 @@
 // frame, so the true transform between the maps is exact. Used by tests, the
 // demo and the benchmarks.
 
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/Similarity2D.h>
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -67,6 +68,14 @@ mrpt::maps::COccupancyGridMap2D renderGrid(
 	const ScanSequence& scans, size_t begin, size_t end, double resolution,
 	const mrpt::poses::CPose2D& frame = {}, float max_range = 15.0f,
 	float free_update_certainty = 0.0f);
+
+/** The same map as a SLAM system would save it, with its origin off the cell
+ * lattice: rendered in `frame` ⊕ (dx, dy) and held with origin (dx, dy), so
+ * the result is the map of `frame` whose cell corners sit at (dx, dy) plus
+ * whole cells. Saved as map_server files, it is what users feed the aligner. */
+GridInFrame renderGridOffLattice(
+	const ScanSequence& scans, size_t begin, size_t end, double resolution,
+	const mrpt::poses::CPose2D& frame, double dx, double dy, float max_range = 15.0f);
 
 GroundTruthPair makeGroundTruthPair(const ScanSequence& scans, const PairSpec& spec);
 

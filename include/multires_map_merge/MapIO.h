@@ -2,7 +2,7 @@
 // Reading and writing grid maps by file extension. Every failure throws
 // MapIOError with a message that names the file and the problem.
 
-#include <multires_map_merge/Similarity2D.h>
+#include <multires_map_merge/GridInFrame.h>
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
@@ -16,18 +16,27 @@ struct MapIOError : std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
-/** Loads .gridmap / .gridmap.gz (a serialized COccupancyGridMap2D),
- * map_server .yaml (+ its image), or .simplemap / .simplemap.gz (rendered at
- * `simplemap_resolution` metres). Rejects empty maps and non-finite metadata. */
-mrpt::maps::COccupancyGridMap2D loadGridMap(
-	const std::string& path, double simplemap_resolution = 0.05);
+/** Loads, by extension:
+ * - map_server `.yaml` (+ its image), read as ROS 1 map_server reads it:
+ *   `mode` trinary | scale | raw, `negate`, `occupied_thresh`, `free_thresh`,
+ *   image path relative to the yaml, colour images averaged over their
+ *   channels. The grid is in its origin frame and `origin` holds the file's
+ *   `origin: [x, y, yaw]` exactly (any position, any yaw).
+ * - `.gridmap` / `.gridmap.gz` (a serialized COccupancyGridMap2D): the grid as
+ *   stored, identity origin.
+ * - `.simplemap` / `.simplemap.gz`: rendered at `simplemap_resolution` metres.
+ * Rejects empty maps, non-finite metadata and files it cannot read. */
+GridInFrame loadGridMap(const std::string& path, double simplemap_resolution = 0.05);
 
 /** Saves .gridmap.gz / .gridmap, or map_server .yaml plus a .pgm beside it
- * (occupied 0, free 254, unknown 205; origin = the grid's lower-left corner).
- * `frame` (rigid) places the grid's metric frame in the file's frame; only a
- * .yaml origin [x, y, yaw] can hold a non-identity one exactly. */
-void saveGridMap(
-	const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path, const Similarity2D& frame = {});
+ * (occupied 0, free 254, unknown 205; trinary; origin = the corner of cell
+ * (0, 0) in the map's frame, with its yaw). A .yaml holds the origin exactly.
+ * A .gridmap cannot hold a rotated origin (MapIOError) and snaps the corner to
+ * a multiple of the cell size: the return value then says by how much the
+ * written map is shifted ("" when the file holds the map exactly). */
+std::string saveGridMap(const GridInFrame& map, const std::string& path);
+/** A grid whose own metric frame is the map's frame. */
+std::string saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
 
 bool hasSuffix(const std::string& s, const std::string& suffix);
 

@@ -43,9 +43,9 @@ int main(int argc, char** argv)
 				std_msgs::Header h;
 				h.stamp = ros::Time(1);
 				h.frame_id = "robot1/map";
-				bag.write("/robot1/map", h.stamp, ros1::msgFromGrid(pair.ref, {}, h));
+				bag.write("/robot1/map", h.stamp, ros1::msgFromGrid({pair.ref, {}}, h));
 				h.frame_id = "robot2/map";
-				bag.write("/robot2/map", h.stamp, ros1::msgFromGrid(pair.other, {}, h));
+				bag.write("/robot2/map", h.stamp, ros1::msgFromGrid({pair.other, {}}, h));
 			}
 			std::printf(
 				"Rendered two overlapping parts of the real malaga run:\n"

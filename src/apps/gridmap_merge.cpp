@@ -45,33 +45,22 @@ double outputResolution(const std::string& spec, double ref_res, double other_re
 	throw UsageError("--output-resolution must be 'reference', 'finest' or metres > 0, not '" + spec + "'");
 }
 
-/** Two maps, each in its metric frame, and where that frame sits in the
- * frame the user names the map by (identity for files; a ROS map's origin
- * pose for bag messages). */
+/** Two maps, each a grid in its exact frame: a map_server origin, a ROS
+ * message's info.origin (identity for .gridmap files). */
 struct Inputs
 {
-	mrpt::maps::COccupancyGridMap2D ref, other;
-	Similarity2D ref_frame, other_frame;
+	GridInFrame ref, other;
 };
 
 Inputs fromFiles(const std::string& ref, const std::string& other, double simplemap_res)
 {
-	Inputs in;
-	in.ref = loadGridMap(ref, simplemap_res);
-	in.other = loadGridMap(other, simplemap_res);
-	return in;
+	return {loadGridMap(ref, simplemap_res), loadGridMap(other, simplemap_res)};
 }
 
 Inputs fromBag(const std::string& bag, const std::vector<std::string>& topics)
 {
-	Inputs in;
-	auto ref = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[0]).back(), topics[0]);
-	auto other = ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[1]).back(), topics[1]);
-	in.ref = std::move(ref.grid);
-	in.other = std::move(other.grid);
-	in.ref_frame = ref.origin;
-	in.other_frame = other.origin;
-	return in;
+	return {ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[0]).back(), topics[0]),
+			ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[1]).back(), topics[1])};
 }
 
 /** TCLAP takes one value per flag: "--topics A B" becomes "--topics A --topics B". */
@@ -167,21 +156,19 @@ int main(int argc, char** argv)
 												: maps_arg.getValue()[1];
 		const Inputs in = bag_mode ? fromBag(bag_arg.getValue(), topics_arg.getValue())
 								   : fromFiles(ref_name, other_name, smres_arg.getValue());
-		const bool framed = in.ref_frame.yaw != 0 || !in.ref_frame.t.isZero();
-		if (framed && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
+		// A .gridmap holds no rotation: say so before any work.
+		if (in.ref.origin.yaw != 0 && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
 			throw UsageError(
-				"--out: " + ref_name + " has an origin pose only a .yaml map can hold exactly; save as .yaml");
-		const auto& ref = in.ref;
-		const auto& other = in.other;
+				"--out: " + ref_name + " has a rotated origin, which only a .yaml map can hold; save as .yaml");
+		const auto& ref = in.ref.grid;
+		const auto& other = in.other.grid;
 		std::cout << "REF   " << ref_name << ": " << ref.getSizeX() << "x" << ref.getSizeY()
 				  << " cells, stated " << ref.getResolution() << " m\n"
 				  << "OTHER " << other_name << ": " << other.getSizeX() << "x" << other.getSizeY()
 				  << " cells, stated " << other.getResolution() << " m\n";
 
-		r = aligner.alignScaled(ref, other);
-		// Fusion works in the grids' frames; the report is between the maps' frames.
-		const Similarity2D grids_metric = r.metric;
-		r.metric = in.ref_frame.compose(r.metric).compose(in.other_frame.inverse());
+		// Between the maps' frames, exact for any origin.
+		r = aligner.alignScaled(in.ref, in.other);
 		double res = 0;
 		if (r.success) res = outputResolution(outres_arg.getValue(), ref.getResolution(), r.implied_resolution_other);
 		if (!r.success)
@@ -198,13 +185,14 @@ int main(int argc, char** argv)
 
 		if (out_arg.isSet() || png_arg.isSet())
 		{
-			const FusedMap fused = fuseGridMaps(ref, other, grids_metric, res);
-			std::cout << "  merged map: " << fused.merged.getSizeX() << "x" << fused.merged.getSizeY()
-					  << " cells at " << fused.merged.getResolution() << " m\n";
+			const FusedMap fused = fuseGridMaps(in.ref, in.other, r.metric, res);
+			std::cout << "  merged map: " << fused.merged.grid.getSizeX() << "x" << fused.merged.grid.getSizeY()
+					  << " cells at " << fused.merged.grid.getResolution() << " m\n";
 			if (out_arg.isSet())
 			{
-				saveGridMap(fused.merged, out_arg.getValue(), in.ref_frame);
+				const std::string note = saveGridMap(fused.merged, out_arg.getValue());
 				std::cout << "  wrote " << out_arg.getValue() << "\n";
+				if (!note.empty()) std::cerr << "gridmap-merge: note: " << note << "\n";
 			}
 			if (png_arg.isSet())
 			{

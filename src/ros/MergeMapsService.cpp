@@ -34,7 +34,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 		CScalingGridMapAligner aligner;
 		aligner.options = params_;
 		aligner.options.use_resolution_metadata = params_.use_resolution_metadata || req.use_resolution_metadata;
-		const auto info = aligner.alignScaled(ref.grid, other.grid);
+		const auto info = aligner.alignScaled(ref, other);
 		if (details) details->info = info;
 		res.overlap = info.overlap;
 		res.confidence = info.confidence;
@@ -42,8 +42,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 			res.message = "not merged: " + info.message;
 		else
 		{
-			// Between the messages' frames: through each grid's origin frame.
-			const Similarity2D world = ref.origin.compose(info.metric).compose(other.origin.inverse());
+			const Similarity2D& world = info.metric;  // between the messages' frames
 			res.transform.x = world.t.x();
 			res.transform.y = world.t.y();
 			res.transform.theta = world.yaw;
@@ -54,8 +53,8 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 			const double out_res = out_res_req > 0 ? out_res_req : ref.grid.getResolution();
 			try
 			{
-				FusedMap fused = fuseGridMaps(ref.grid, other.grid, info.metric, out_res, max_merged_cells);
-				res.merged = msgFromGrid(fused.merged, ref.origin, req.reference.header);
+				FusedMap fused = fuseGridMaps(ref, other, info.metric, out_res, max_merged_cells);
+				res.merged = msgFromGrid(fused.merged, req.reference.header);
 				if (details) details->fused = std::move(fused);
 				res.success = true;
 				res.message = "merged";

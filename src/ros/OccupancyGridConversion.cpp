@@ -102,12 +102,12 @@ GridInFrame gridFromMsg(const nav_msgs::OccupancyGrid& msg, const std::string& w
 	return out;
 }
 
-nav_msgs::OccupancyGrid msgFromGrid(
-	const mrpt::maps::COccupancyGridMap2D& grid, const Similarity2D& origin, const std_msgs::Header& header)
+nav_msgs::OccupancyGrid msgFromGrid(const GridInFrame& map, const std_msgs::Header& header)
 {
 	nav_msgs::OccupancyGrid msg;
-	mrpt::ros1bridge::toROS(grid, msg, header);
-	const Eigen::Vector2d corner = origin.apply({grid.getXMin(), grid.getYMin()});
+	mrpt::ros1bridge::toROS(map.grid, msg, header);
+	const Similarity2D& origin = map.origin;
+	const Eigen::Vector2d corner = map.cornerInMapFrame();
 	msg.info.map_load_time = header.stamp;
 	msg.info.origin = geometry_msgs::Pose();
 	msg.info.origin.position.x = corner.x();

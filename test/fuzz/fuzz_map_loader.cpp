@@ -54,7 +54,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 	if (data[0] % 4 != 3) write(path, data + 1, size - 1);
 	try
 	{
-		const auto g = loadGridMap(path);
+		const auto g = loadGridMap(path).grid;
 		if (g.getSizeX() == 0 || g.getSizeY() == 0 || !(g.getResolution() > 0)) __builtin_trap();
 	}
 	catch (const MapIOError&)

@@ -9,7 +9,7 @@
 // handles rotated origins exactly and keeps ros1bridge's float coordinates
 // small, so its grid size always equals width×height.
 
-#include <multires_map_merge/Similarity2D.h>
+#include <multires_map_merge/GridInFrame.h>
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -25,24 +25,18 @@ struct InvalidGridMessage : std::invalid_argument
 	using std::invalid_argument::invalid_argument;
 };
 
-struct GridInFrame
-{
-	mrpt::maps::COccupancyGridMap2D grid;  //!< in its origin frame
-	Similarity2D origin;  //!< origin frame → the message's frame (rigid)
-};
-
-/** Validates and converts. `what` names the map in error messages ("reference").
+/** Validates and converts to a grid in its origin frame; `origin` is the
+ * message's info.origin (into header.frame_id). `what` names the map in error messages ("reference").
  * Accepts: width, height ≥ 1; data.size() = width×height; a finite resolution
  * > 0; a finite origin whose orientation is a rotation about z (any norm; the
  * all-zero quaternion of a default-constructed message counts as identity);
  * cell values -1 (unknown) or 0..100. Throws InvalidGridMessage otherwise. */
 GridInFrame gridFromMsg(const nav_msgs::OccupancyGrid& msg, const std::string& what = "map");
 
-/** A grid in the origin frame `origin` (rigid, into header.frame_id) as a
- * message: cells through ros1bridge, info.origin = origin ∘ (grid's corner). */
-nav_msgs::OccupancyGrid msgFromGrid(
-	const mrpt::maps::COccupancyGridMap2D& grid, const Similarity2D& origin,
-	const std_msgs::Header& header);
+/** A grid in its frame (map.origin: rigid, into header.frame_id) as a
+ * message: cells through ros1bridge, info.origin = the corner of cell (0, 0)
+ * in that frame, with the frame's yaw. */
+nav_msgs::OccupancyGrid msgFromGrid(const GridInFrame& map, const std_msgs::Header& header);
 
 /** The pose of info.origin as a rigid Similarity2D; throws InvalidGridMessage
  * when it is not finite or not a rotation about z. */

@@ -1,0 +1,39 @@
+#pragma once
+// A grid and the exact pose of its frame. MRPT grids keep their lower-left
+// corner on a multiple of the cell size, so a map whose origin is anywhere
+// else (every map_server file, every nav_msgs/OccupancyGrid) is held as a grid
+// in its *origin frame* — corner at (0, 0), axes along the grid — plus the
+// rigid pose of that frame in the frame the map is named in. Nothing is
+// rounded, and rotated origins are exact.
+
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/Similarity2D.h>
+
+#include <mrpt/maps/COccupancyGridMap2D.h>
+
+namespace multires_map_merge
+{
+struct GridInFrame
+{
+	mrpt::maps::COccupancyGridMap2D grid;  //!< metres in its own (origin) frame
+	/** Rigid (scale 1): the grid's metric frame → the map's frame (a
+	 * map_server `origin`, a message's `info.origin`). Identity for .gridmap
+	 * files, whose frame is the grid's own. */
+	Similarity2D origin;
+
+	/** Cell coordinates (cell centres at integers) → the map's frame. */
+	Similarity2D cellToMapFrame() const { return origin.compose(cellToMetric(grid)); }
+	/** The lower-left corner of cell (0, 0) in the map's frame. */
+	Eigen::Vector2d cornerInMapFrame() const { return origin.apply({grid.getXMin(), grid.getYMin()}); }
+	bool originIsIdentity() const { return origin.yaw == 0 && origin.t.isZero() && origin.scale == 1; }
+};
+
+/** Re-expresses a transform between two grids' metric frames as one between
+ * their maps' frames: ref.origin ∘ between_grids ∘ other.origin⁻¹. */
+Similarity2D betweenMapFrames(
+	const GridInFrame& ref, const Similarity2D& between_grids, const GridInFrame& other);
+/** The inverse: between the maps' frames → between the grids' frames. */
+Similarity2D betweenGrids(
+	const GridInFrame& ref, const Similarity2D& between_map_frames, const GridInFrame& other);
+
+}  // namespace multires_map_merge
