@@ -2,6 +2,7 @@
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/MapAgreement.h>
+#include <multires_map_merge/StructureHypotheses.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
@@ -32,10 +33,17 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(ransac_min_inliers, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(hypotheses_per_level_pair, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(max_hypotheses, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(structure_search, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(xi_min, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lambda, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_relative_tolerance, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(verify_tolerance, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(verify_shift, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_chance_weight, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_threshold, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_confidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(use_resolution_metadata, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(metadata_scale_tolerance, double, c, s);
@@ -64,6 +72,12 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("lambda", lambda, 0, 100);
 	in("icp_max_iterations", icp_max_iterations, 1, 1e5);
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
+	in("verify_tolerance", verify_tolerance, 0.5, 50);
+	in("verify_shift", verify_shift, 1, 1000);
+	in("verify_turn_deg", verify_turn_deg, 1, 90);
+	in("decision_chance_weight", decision_chance_weight, 0, 10);
+	in("decision_evidence", decision_evidence, 0, 1e6);
+	in("decision_threshold", decision_threshold, 0, 10);
 	in("min_confidence", min_confidence, 0, 1);
 	in("metadata_scale_tolerance", metadata_scale_tolerance, 0, 10);
 	in("max_map_cells", max_map_cells, 64, 1e10);
@@ -82,10 +96,17 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(ransac_min_inliers, "Fewest RANSAC inliers for a hypothesis");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(hypotheses_per_level_pair, "RANSAC re-runs per level pair");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Try structure hypotheses when no feature one is confident");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = T + w (T - chance T) - sqrt(evidence / judged)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_threshold, "Score at confidence 0.5 (calibrated)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(min_confidence, "Below this the maps are reported as not merged");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(use_resolution_metadata, "Use the stated resolutions as a scale prior");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(metadata_scale_tolerance, "Relative scale tolerance of that prior");
@@ -132,19 +153,60 @@ std::string checkGrid(const COccupancyGridMap2D& g, const char* which)
 	return why.str();
 }
 
-// Confidence in [0,1] from the cell agreement, discounted when the overlap
-// TsICP settled on is pinned at ξmin (the sign of a wrong start) or when the
-// fitted edges sit far apart. A pinned ξ whose pairs fit to a fraction of a
-// cell is no such sign: maps whose edges coincide exactly on part of the
-// overlap (same resolution, whole-cell offsets) make ψ = 0 there, and any
-// larger ξ loses to it.
-double confidenceOf(double consistency, double overlap, double xi_min, double rmse_coarse)
+// Confidence that two maps coincide cell for cell (two parts of one SLAM
+// run: walls within a cell), from the strict cell agreement, discounted when
+// the overlap TsICP settled on is pinned at ξmin (the sign of a wrong start)
+// or when the fitted edges sit far apart. A pinned ξ whose pairs fit to a
+// fraction of a cell is no such sign: maps whose edges coincide exactly on
+// part of the overlap make ψ = 0 there, and any larger ξ loses to it.
+double exactConfidence(double consistency, double overlap, double xi_min, double rmse_coarse)
 {
 	const double exact = std::clamp((0.5 - rmse_coarse) / 0.2, 0.0, 1.0);
 	const double pinned = std::max(exact, std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0));
 	const double tight = std::clamp(1.5 - rmse_coarse, 0.0, 1.0);
 	const double agree = std::clamp((consistency - 0.7) / 0.25, 0.0, 1.0);
 	return agree * std::min(pinned, tight);
+}
+
+// Fewer wall points than this on the other map's seen space (in the weaker
+// direction) is too little overlap to judge.
+constexpr size_t kMinJudgedPoints = 40;
+}  // namespace
+
+namespace
+{
+/** Share of `points` that `t` moves onto the target's known space. */
+double shareOnKnown(const PointList& points, const Similarity2D& t, const OccupancyField& target)
+{
+	if (points.empty()) return 0;
+	size_t on = 0;
+	for (const auto& p : points)
+	{
+		const Eigen::Vector2d q = t(p);
+		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+		on += x >= 0 && y >= 0 && x < target.known.cols && y < target.known.rows && target.known.at<uint8_t>(y, x);
+	}
+	return double(on) / points.size();
+}
+
+/** TsICP trims to the share ξ ≥ ξmin of its fixed set's points that find a
+ * partner, so the fixed set should be the map that lies more inside the
+ * other (a small map inside a large one): judged at the start transform.
+ * The result is always other → ref, in reference cells. */
+TsICPResult refineFromTheInside(
+	const PointList& ref_edges, const OccupancyField& ref_field, const PointList& other_edges,
+	const OccupancyField& other_field, const Similarity2D& start, const TsICPParams& ip)
+{
+	const double ref_inside = shareOnKnown(ref_edges, start.inverse(), other_field);
+	const double other_inside = shareOnKnown(other_edges, start, ref_field);
+	if (other_inside <= ref_inside) return runTsICP(ref_edges, other_edges, start, ip);
+	TsICPResult r = runTsICP(other_edges, ref_edges, start.inverse(), ip);
+	const double s2 = 1.0 / (r.transform.scale * r.transform.scale);  // other cells² → ref cells²
+	r.transform = r.transform.inverse();
+	r.trimmed_mse *= s2;
+	r.objective *= s2;
+	for (auto& o : r.objective_history) o *= s2;
+	return r;
 }
 }  // namespace
 
@@ -197,12 +259,11 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		ref_feats, other_feats, fp, expected_scale, options.metadata_scale_tolerance);
 	info.stage_seconds["ransac"] = stage.Tac();
 	info.hypotheses = hyps.size();
-	if (hyps.empty())
-		return fail("no consistent feature matches between the maps (do they overlap?)");
 
 	// 2. Edge points.
 	stage.Tic();
 	const PointList ref_edges = edgePoints(ref_img), other_edges = edgePoints(other_img);
+	const OccupancyField ref_field = occupancyField(ref_img), other_field = occupancyField(other_img);
 	info.ref_edge_points = ref_edges.size();
 	info.other_edge_points = other_edges.size();
 	info.stage_seconds["edges"] = stage.Tac();
@@ -214,12 +275,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const TsICPParams ip = options.icpParams();
 	double icp_s = 0, verify_s = 0;
 	bool have = false;
-	for (const auto& h : hyps)
+	auto refineAll = [&](const std::vector<Hypothesis>& list) {
+	int budget = options.max_hypotheses;
+	for (const auto& h : list)
 	{
-		if (static_cast<int>(info.hypotheses_refined) >= options.max_hypotheses) break;
+		if (budget-- <= 0) break;
 		++info.hypotheses_refined;
 		stage.Tic();
-		const TsICPResult r = runTsICP(ref_edges, other_edges, h.other_to_ref, ip);
+		const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
 		icp_s += stage.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0)) continue;
 		if (expected_scale &&
@@ -227,16 +290,43 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 				std::log1p(options.metadata_scale_tolerance))
 			continue;
 
+		// 4. Judge on the cells, against chance (MapAgreement.h).
 		stage.Tic();
 		const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
+		const TwoWaySupport sup = twoWaySupport(
+			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
+		const Chance chance = chanceSupport(
+			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
+			options.verify_shift, options.verify_turn_deg);
 		verify_s += stage.Tac();
 		const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
 		const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
-		const double conf = confidenceOf(ag.consistency, r.overlap, ip.xi_min, rmse_coarse);
+		TCandidate cand;
+		cand.initial_cells = h.other_to_ref;
+		cand.cells = r.transform;
+		cand.overlap = r.overlap;
+		cand.rmse_coarse_cells = rmse_coarse;
+		cand.consistency = ag.consistency;
+		cand.tolerant_consistency = sup.consistency();
+		cand.chance_consistency = chance.consistency;
+		cand.support = sup.score();
+		cand.judged_points = sup.judged();
+		cand.score = cand.tolerant_consistency +
+			options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
+			std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
+		// Two ways to be sure: the maps coincide cell for cell, or (independent
+		// maps) their walls agree within the tolerance well above chance.
+		const double tolerant_conf = cand.judged_points < kMinJudgedPoints
+			? 0.0
+			: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
+		const double conf = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
+		cand.confidence = conf;
+		info.candidates.push_back(cand);
 		MRPT_LOG_DEBUG_STREAM(
-			"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform
-						  << " xi " << r.overlap << " psi " << r.objective << " rmse "
-						  << rmse_coarse << " consistency " << ag.consistency << " conf " << conf);
+			"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
+						  << r.overlap << " rmse " << rmse_coarse << " tolerant consistency "
+						  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
+						  << cand.score << " conf " << conf);
 		if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
 			continue;
 		have = true;
@@ -245,7 +335,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		info.overlap = r.overlap;
 		info.objective = r.objective;
 		info.trimmed_rmse_coarse_cells = rmse_coarse;
-		info.consistency = ag.consistency;
+		info.consistency = cand.tolerant_consistency;
+		info.chance_consistency = cand.chance_consistency;
 		info.confidence = conf;
 		info.ransac_inliers = h.inliers;
 		info.ransac_matches = h.matches;
@@ -253,9 +344,23 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		info.objective_history = r.objective_history;
 		if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
 	}
+	};
+	refineAll(hyps);
+	// Where no feature hypothesis convinces, the building's structure may
+	// (StructureHypotheses.h): independent maps whose corners differ.
+	if (options.structure_search && (!have || info.confidence < options.min_confidence))
+	{
+		stage.Tic();
+		const auto more = structureHypotheses(ref_img, other_img, {}, expected_scale);
+		info.stage_seconds["structure"] = stage.Tac();
+		info.hypotheses += more.size();
+		refineAll(more);
+	}
 	info.stage_seconds["icp"] = icp_s;
 	info.stage_seconds["verify"] = verify_s;
-	if (!have) return fail("no hypothesis survived refinement");
+	if (!have)
+		return fail(info.hypotheses ? "no hypothesis survived refinement"
+									: "no consistent feature matches or structure between the maps (do they overlap?)");
 
 	info.metric = cellToMetric(ref).compose(info.cells).compose(cellToMetric(other).inverse());
 	info.implied_resolution_other = info.cells.scale * ref.getResolution();
@@ -264,8 +369,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	{
 		std::ostringstream why;
 		why << "alignment not confident enough (confidence " << info.confidence << " < "
-			<< options.min_confidence << "; cell consistency " << info.consistency << ", overlap "
-			<< info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
+			<< options.min_confidence << "; tolerant consistency " << info.consistency << " against "
+			<< info.chance_consistency << " by chance, overlap " << info.overlap << ", edge RMSE "
+			<< info.trimmed_rmse_coarse_cells << " cells)";
 		return fail(why.str());
 	}
 	info.success = true;

@@ -3,8 +3,10 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 namespace multires_map_merge
 {
@@ -32,19 +34,67 @@ std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const 
 
 std::optional<Similarity2D> ransacSimilarity(
 	const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to, double threshold,
-	int iterations, double confidence, int min_inliers, std::vector<uchar>& inlier_mask)
+	int iterations, double confidence, int min_inliers, std::vector<uchar>& inlier_mask, double min_scale,
+	double max_scale)
 {
 	inlier_mask.assign(from.size(), 0);
-	if (from.size() < 2 || from.size() != to.size()) return std::nullopt;
-	cv::Mat m = cv::estimateAffinePartial2D(
-		from, to, inlier_mask, cv::RANSAC, threshold, static_cast<size_t>(iterations), confidence, 10);
-	if (m.empty() || cv::countNonZero(inlier_mask) < min_inliers) return std::nullopt;
-	Eigen::Matrix<double, 2, 3> e;
-	for (int r = 0; r < 2; ++r)
-		for (int c = 0; c < 3; ++c) e(r, c) = m.at<double>(r, c);
-	auto s = Similarity2D::fromMatrix(e);
-	if (!s.isFinite() || !(s.scale > 0)) return std::nullopt;
-	return s;
+	const size_t n = from.size();
+	if (n < 2 || n != to.size()) return std::nullopt;
+	const double thr2 = threshold * threshold;
+	auto countInliers = [&](const Similarity2D& m, std::vector<uchar>* mask) {
+		const Eigen::Matrix2d a = m.linear();
+		int count = 0;
+		for (size_t k = 0; k < n; ++k)
+		{
+			const Eigen::Vector2d q = a * Eigen::Vector2d(from[k].x, from[k].y) + m.t;
+			const bool in = (q - Eigen::Vector2d(to[k].x, to[k].y)).squaredNorm() <= thr2;
+			count += in;
+			if (mask) (*mask)[k] = in;
+		}
+		return count;
+	};
+	std::mt19937 rng(12345);  // the same maps give the same hypotheses
+	std::uniform_int_distribution<size_t> pick(0, n - 1);
+	std::optional<Similarity2D> best;
+	int best_count = 0;
+	long needed = iterations;
+	for (long it = 0; it < needed; ++it)
+	{
+		const size_t a = pick(rng), b = pick(rng);
+		if (a == b) continue;
+		const Eigen::Vector2d df(from[b].x - from[a].x, from[b].y - from[a].y);
+		const Eigen::Vector2d dt(to[b].x - to[a].x, to[b].y - to[a].y);
+		if (df.norm() < 1e-6 || dt.norm() < 1e-6) continue;
+		const double scale = dt.norm() / df.norm();
+		if (scale < min_scale || scale > max_scale) continue;
+		Similarity2D m(scale, std::atan2(dt.y(), dt.x()) - std::atan2(df.y(), df.x()), {0, 0});
+		m.t = Eigen::Vector2d(to[a].x, to[a].y) - m.linear() * Eigen::Vector2d(from[a].x, from[a].y);
+		const int count = countInliers(m, nullptr);
+		if (count <= best_count) continue;
+		best_count = count, best = m;
+		// Adaptive stop: enough draws to see an all-inlier pair with `confidence`.
+		const double w = double(count) / n;
+		const double miss = 1 - w * w;
+		if (miss <= 0)
+			needed = it + 1;
+		else
+			needed = std::min<long>(iterations, static_cast<long>(std::ceil(std::log(1 - confidence) / std::log(miss))));
+	}
+	if (!best || best_count < std::max(2, min_inliers)) return std::nullopt;
+	// Re-fit on the inliers (least squares), keep it if it explains as much.
+	std::vector<uchar> mask(n, 0);
+	countInliers(*best, &mask);
+	Eigen::Matrix2Xd src(2, best_count), dst(2, best_count);
+	for (size_t k = 0, c = 0; k < n; ++k)
+		if (mask[k]) src.col(c) << from[k].x, from[k].y, dst.col(c) << to[k].x, to[k].y, ++c;
+	const Similarity2D refit = Similarity2D::fromMatrix(Eigen::Matrix3d(Eigen::umeyama(src, dst, true)));
+	std::vector<uchar> refit_mask(n, 0);
+	if (refit.isFinite() && refit.scale >= min_scale && refit.scale <= max_scale &&
+		countInliers(refit, &refit_mask) >= best_count)
+		best = refit, mask.swap(refit_mask);
+	inlier_mask = mask;
+	if (cv::countNonZero(inlier_mask) < min_inliers) return std::nullopt;
+	return best;
 }
 
 namespace
@@ -78,11 +128,16 @@ std::vector<Hypothesis> featureHypotheses(
 					to.push_back(ref[i].points[m[0].trainIdx]);
 				}
 			const double thr = p.ransac_threshold / ref[i].scale;
+			// Levels of equal cell size match best: this pair looks for a
+			// scale near other level / ref level, within a factor of 2 (the
+			// neighbouring level pairs cover the rest).
+			const double level_scale = other[j].scale / ref[i].scale;
 			for (int k = 0; k < p.hypotheses_per_level_pair; ++k)
 			{
 				std::vector<uchar> mask;
 				auto s = ransacSimilarity(
-					from, to, thr, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask);
+					from, to, thr, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask, level_scale / 2,
+					level_scale * 2);
 				if (!s) break;
 				found.push_back({*s, cv::countNonZero(mask), static_cast<int>(from.size()),
 								 static_cast<int>(i), static_cast<int>(j)});

@@ -32,6 +32,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"objective", num(r.objective)},
 		{"inliers", r.ransac_inliers},
 		{"consistency", num(r.consistency)},
+		{"chance_consistency", num(r.chance_consistency)},
 		{"confidence", num(r.confidence)},
 		{"icp_iterations", r.icp_iterations},
 		{"runtime_s", num(runtime_s)},

@@ -5,6 +5,7 @@
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapAgreement.h>
+#include <multires_map_merge/StructureHypotheses.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -131,14 +132,23 @@ TEST(FeatureHypotheses, PyramidFindsAFiveTimesScaleOnARealMap)
 	EXPECT_GT(hyps.front().inliers, 10);
 }
 
-TEST(MapAgreement, HighAtTruthLowWhenShifted)
+namespace
+{
+// A real pair at 5 and 10 cm, the second turned and shifted.
+GroundTruthPair malaga5and10()
 {
 	const ScanSequence s = loadScans(test::mrptDataset("malaga-cs-fac-building.simplemap.gz"));
 	PairSpec spec;
 	spec.ref_resolution = 0.05;
 	spec.other_resolution = 0.1;
 	spec.other_frame = mrpt::poses::CPose2D(3, 1, 1.0);
-	const auto pair = makeGroundTruthPair(s, spec);
+	return makeGroundTruthPair(s, spec);
+}
+}  // namespace
+
+TEST(MapAgreement, HighAtTruthLowWhenShifted)
+{
+	const auto pair = malaga5and10();
 	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
 	const Similarity2D truth = pair.otherCellsToRefCells();
 	const Agreement good = mapAgreement(a, b, truth);
@@ -146,4 +156,45 @@ TEST(MapAgreement, HighAtTruthLowWhenShifted)
 	EXPECT_GT(good.consistency, 0.95);
 	EXPECT_LT(bad.consistency, 0.8);
 	EXPECT_GT(good.occupied_overlap, 1000u);
+}
+
+TEST(MapAgreement, TolerantConsistencyIsAPeakAboveChance)
+{
+	// At the truth the walls agree and beat the same transform moved far
+	// away; moved far away they do not.
+	const auto pair = malaga5and10();
+	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
+	const PointList ea = edgePoints(a), eb = edgePoints(b);
+	const OccupancyField fa = occupancyField(a), fb = occupancyField(b);
+	const Similarity2D truth = pair.otherCellsToRefCells();
+	const TwoWaySupport at_truth = twoWaySupport(ea, fa, eb, fb, truth, 3.0);
+	const Chance chance = chanceSupport(ea, fa, eb, fb, truth, 3.0, 12.0, 8.0);
+	EXPECT_GT(at_truth.consistency(), 0.9);
+	EXPECT_GT(at_truth.consistency(), chance.consistency + 0.1);
+	EXPECT_GT(at_truth.judged(), 500u);
+	// Bent walls (a 2-cell shift of the coarser map) still agree.
+	const TwoWaySupport bent = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {4, 0}).compose(truth), 3.0);
+	EXPECT_GT(bent.consistency(), 0.8);
+	const TwoWaySupport far = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {60, 0}).compose(truth), 3.0);
+	EXPECT_LT(far.consistency(), at_truth.consistency() - 0.15);
+}
+
+TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
+{
+	// The same real map at 5 and 8 cm (rendered from the scans), the coarse
+	// one turned by 117° and moved: the wall directions give the turn, the
+	// wall correlation the translation, the scale ladder the scale.
+	const cv::Mat fine = realClasses(0.05), coarse0 = realClasses(0.08);
+	const Similarity2D turn(1.0, 117 * M_PI / 180, {700, 200});
+	const cv::Mat coarse = warpClasses(coarse0, turn, cv::Size(900, 900));
+	EXPECT_NEAR(
+		std::abs(wrapToPi(4 * (dominantWallDirection(coarse) - dominantWallDirection(fine) - turn.yaw))) / 4, 0,
+		3 * M_PI / 180);
+	const auto hyps = structureHypotheses(fine, coarse);
+	ASSERT_FALSE(hyps.empty());
+	bool found = false;
+	for (const auto& h : hyps)
+		found |= std::abs(std::log(h.other_to_ref.scale / 1.6)) < 0.12 &&
+			std::abs(wrapToPi(h.other_to_ref.yaw + turn.yaw)) < 4 * M_PI / 180;
+	EXPECT_TRUE(found) << "no hypothesis near scale 1.6, yaw -117°";
 }

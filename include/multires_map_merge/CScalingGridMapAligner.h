@@ -41,12 +41,31 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		int ransac_min_inliers = 5;
 		int hypotheses_per_level_pair = 2;
 		int max_hypotheses = 8;  //!< refined by TsICP, most inliers first
+		/** When no feature hypothesis is confident, also try hypotheses from
+		 * the maps' structure (StructureHypotheses.h). */
+		bool structure_search = true;
 		// --- TsICP
 		double xi_min = 0.35;
 		double lambda = 2.0;
 		int icp_max_iterations = 100;
 		double icp_relative_tolerance = 1e-7;
-		// --- Decision
+		// --- Decision (README "How the decision works"; calibrated by
+		// scripts/calibrate_decision.py on Halmstad E5/HIH and CARMEN negatives)
+		/** Walls within this many cells of the coarser map agree: independent
+		 * SLAM maps bend and thicken walls by a few cells. */
+		double verify_tolerance = 3.0;
+		/** The far perturbations that measure chance: shifts of this many
+		 * coarse cells along each axis, turns of ± verify_turn_deg. */
+		double verify_shift = 12.0;
+		double verify_turn_deg = 8.0;
+		// Calibrated (scripts/calibrate_decision.py, bench/results/calibration.txt):
+		// no wrong calibration candidate (mirror images included) passes.
+		double decision_chance_weight = 1.0;
+		/** Evidence discount: the score loses √(decision_evidence / n) for n
+		 * judged wall points (a small overlap proves little). */
+		double decision_evidence = 400;
+		/** The score at which confidence is 0.5; ±0.1 around it spans 0..1. */
+		double decision_threshold = 0.477;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -71,8 +90,27 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		TsICPParams icpParams() const;
 	} options;
 
+	/** One refined hypothesis and how it was judged. */
+	struct TCandidate
+	{
+		Similarity2D initial_cells, cells;  //!< RANSAC start, TsICP result (cell coordinates)
+		double overlap = 0, rmse_coarse_cells = 0;
+		double consistency = 0;  //!< strict cell consistency (MapAgreement), for reference
+		/** Tolerant consistency of both maps' wall points (MapAgreement.h,
+		 * twoWaySupport) and the best of it under far perturbations of the
+		 * same transform: what chance gives in these two maps. */
+		double tolerant_consistency = 0, chance_consistency = 0;
+		double support = 0;  //!< share of wall points near a wall of the other map
+		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
+		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
+		double score = 0;
+		double confidence = 0;
+	};
+
 	struct TReturnInfo : public mrpt::slam::TMetricMapAlignmentResult
 	{
+		/** Every refined hypothesis, in the order refined. */
+		std::vector<TCandidate> candidates;
 		bool success = false;  //!< merged with confidence ≥ min_confidence
 		std::string message;  //!< why not, when not
 		/** x_ref = metric(x_other), metres, each map read with its stated metadata. */
@@ -87,7 +125,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double overlap = 0;  //!< TsICP's ξ
 		double objective = 0;  //!< TsICP's ψ, squared reference cells
 		double trimmed_rmse_coarse_cells = 0;  //!< √e(ξ) in cells of the coarser map
-		double consistency = 0;  //!< MapAgreement
+		/** Tolerant consistency of the chosen candidate (TCandidate), and
+		 * the best of it under far perturbations (chance). */
+		double consistency = 0, chance_consistency = 0;
 		double confidence = 0;  //!< in [0,1]
 		int ransac_inliers = 0;
 		int ransac_matches = 0;

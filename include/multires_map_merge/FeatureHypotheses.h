@@ -64,10 +64,16 @@ std::vector<Hypothesis> featureHypotheses(
 	double scale_tolerance = 0.15);
 
 /** RANSAC over point correspondences for a 4-DOF similarity (2-point
- * minimal sets, cv::estimateAffinePartial2D). Returns std::nullopt if no
- * model reaches min_inliers; `inlier_mask` marks the inliers. */
+ * minimal sets; the model re-fitted on its inliers with Eigen::umeyama).
+ * Only models with a scale in [min_scale, max_scale] are considered:
+ * without that bound, a model that shrinks every point onto one spot
+ * "explains" all matches of a repetitive map, which is why
+ * cv::estimateAffinePartial2D (no such bound) is not used. Deterministic.
+ * Returns std::nullopt if no model reaches min_inliers; `inlier_mask` marks
+ * the inliers. */
 std::optional<Similarity2D> ransacSimilarity(
 	const std::vector<cv::Point2f>& from, const std::vector<cv::Point2f>& to, double threshold,
-	int iterations, double confidence, int min_inliers, std::vector<uchar>& inlier_mask);
+	int iterations, double confidence, int min_inliers, std::vector<uchar>& inlier_mask,
+	double min_scale = 1e-3, double max_scale = 1e3);
 
 }  // namespace multires_map_merge

@@ -5,6 +5,7 @@
 // when both maps have many similar walls.
 
 #include <multires_map_merge/Similarity2D.h>
+#include <multires_map_merge/TsICP.h>
 
 #include <opencv2/core.hpp>
 
@@ -22,7 +23,78 @@ struct Agreement
 	double consistency = 0;
 };
 
+/** `free_margin_coarse_cells`: how far from any obstacle or unknown cell a
+ * free cell must be to count as clearly free (1: quantisation only; larger
+ * values tolerate walls bent or drawn thicker by that much). */
 Agreement mapAgreement(
-	const cv::Mat& ref_classes, const cv::Mat& other_classes, const Similarity2D& other_to_ref_cells);
+	const cv::Mat& ref_classes, const cv::Mat& other_classes, const Similarity2D& other_to_ref_cells,
+	double free_margin_coarse_cells = 1.0);
+
+// ---- Tolerant support: the verification that holds on independent maps ----
+// Two SLAM runs of one building bend their walls by a few cells, draw them
+// thicker or thinner, and see different clutter. What still holds under the
+// right transform: most walls of one map lie *near* walls of the other,
+// wherever the other has seen the space. And what a wrong transform cannot
+// fake: that nearness drops sharply when the transform is moved by a few
+// tolerances (a peak), unlike a repetitive pattern or a lucky overlap.
+
+/** What a map offers for judging points moved into it. */
+struct OccupancyField
+{
+	cv::Mat dist_to_occupied;  //!< CV_32F, cells to the nearest occupied cell
+	cv::Mat dist_to_not_free;  //!< CV_32F, cells to the nearest occupied or unknown cell
+	cv::Mat known;  //!< CV_8U, non-zero where the map has seen the space
+};
+OccupancyField occupancyField(const cv::Mat& classes);
+
+struct Support
+{
+	size_t judged = 0;  //!< points landing on the target's known space
+	size_t supported = 0;  //!< of those, within the tolerance of its walls
+	/** Of those, on free space farther than the tolerance from any wall or
+	 * unknown cell: a wall where the target clearly sees none. */
+	size_t conflicts = 0;
+	double ratio() const { return judged ? double(supported) / double(judged) : 0.0; }
+};
+
+/** `points` (cells of the source map) moved by `source_to_target` (cells)
+ * into the target map: how many land on its known space, and how many of
+ * those within `tolerance` target cells of an occupied cell. */
+Support tolerantSupport(
+	const PointList& points, const Similarity2D& source_to_target, const OccupancyField& target,
+	double tolerance);
+
+/** Both ways, for a transform between two maps' cells. */
+struct TwoWaySupport
+{
+	Support other_in_ref, ref_in_other;
+	/** The weaker direction's ratio: a small map inside a large one is
+	 * judged where they overlap, from both sides. */
+	double score() const { return std::min(other_in_ref.ratio(), ref_in_other.ratio()); }
+	size_t judged() const { return std::min(other_in_ref.judged, ref_in_other.judged); }
+	/** 1 − conflicts / judged over both directions. */
+	double consistency() const
+	{
+		const size_t j = other_in_ref.judged + ref_in_other.judged;
+		return j ? 1.0 - double(other_in_ref.conflicts + ref_in_other.conflicts) / double(j) : 0.0;
+	}
+};
+
+TwoWaySupport twoWaySupport(
+	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells);
+
+/** The best two-way score under "far" perturbations of the transform: the
+ * other map shifted by ±`shift_coarse_cells` along each axis and turned by
+ * ±`turn_deg` about the centre of its points — what chance alone gives in
+ * this pair of maps. */
+struct Chance
+{
+	double support = 0, consistency = 0;  //!< the best of each over the perturbations
+};
+Chance chanceSupport(
+	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	double shift_coarse_cells, double turn_deg);
 
 }  // namespace multires_map_merge

@@ -1,0 +1,81 @@
+#pragma once
+// The Halmstad Robot Maps (../shared/data/halmstad, SOURCES.md §5): real
+// sensor maps of four sites, each made in a separate session, with annotated
+// correspondences and a fitted similarity per ordered pair. Shared by the
+// benchmark ("Real independent maps") and the tests.
+//
+// The PNGs state no cell size: they are fed as map_server files at 0.05 m
+// (0 occupied, 127 unknown, 255 free; a yaml beside the run pointing at the
+// PNG), as a user would. The annotation lives in image pixels (u = column,
+// v = row from the top); a map_server map with origin 0 puts pixel (u, v)'s
+// centre at ((u + ½)·r, (H − v − ½)·r).
+
+#include <multires_map_merge/GridInFrame.h>
+#include <multires_map_merge/Similarity2D.h>
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace multires_bench
+{
+using multires_map_merge::GridInFrame;
+using multires_map_merge::Similarity2D;
+
+constexpr double kHalmstadResolution = 0.05;
+
+/** Calibration sites (the decision may be tuned on them) and acceptance
+ * sites (only reported: never tune on them). */
+inline bool isCalibrationSite(const std::string& site) { return site == "E5" || site == "HIH"; }
+
+struct HalmstadPair
+{
+	std::string site, src, dst;  //!< maps E5_01 …; OTHER = src, REF = dst
+	Similarity2D src_to_dst_px;  //!< the annotation's fitted similarity, image pixels
+	double rms_px = 0;  //!< the fit's own inlier residual
+	std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> inliers;  //!< (src px, dst px)
+};
+
+struct HalmstadOutcome
+{
+	double mean_displacement_px = NAN;  //!< OTHER's occupied pixels, estimate vs annotation
+	double corr_rms_px = NAN;  //!< the annotated inlier correspondences under the estimate
+	bool right = false;  //!< both within the issue's bounds
+};
+
+class HalmstadData
+{
+   public:
+	/** Reads gt_similarity.csv and gt_correspondences.csv.gz under `root`;
+	 * throws std::runtime_error naming the file when they are missing. */
+	explicit HalmstadData(const std::string& root);
+
+	std::vector<std::string> sites() const { return {"E5", "F5", "HIH", "KPT4A"}; }
+	/** The sensor maps of a site, sorted (E5_01 …). */
+	std::vector<std::string> sensorMaps(const std::string& site) const;
+	/** The annotated ordered pair src → dst, or nullptr. */
+	const HalmstadPair* pair(const std::string& src, const std::string& dst) const;
+	/** Every unordered sensor-to-sensor pair of a site once (src < dst). */
+	std::vector<HalmstadPair> unorderedPairs(const std::string& site) const;
+
+	std::string png(const std::string& map) const;
+	/** A map_server yaml for `map` at 0.05 m in `dir` (written once). */
+	std::string yaml(const std::string& map, const std::string& dir) const;
+
+   private:
+	std::string root_;
+	std::map<std::pair<std::string, std::string>, HalmstadPair> pairs_;
+};
+
+/** Judges a transform between the maps' frames (x_ref = est(x_other); REF =
+ * dst, OTHER = src, both loaded from the yamls) against the annotation:
+ * mean displacement ≤ 40 px and correspondence RMS ≤ max(2·rms_px, 40 px). */
+HalmstadOutcome judge(const Similarity2D& est, const HalmstadPair& p, const GridInFrame& other, int ref_rows);
+
+/** The annotation as a transform between the maps' frames (metres), for maps
+ * of `src_rows` and `dst_rows` pixel rows. */
+Similarity2D truthBetweenMapFrames(const HalmstadPair& p, int src_rows, int dst_rows);
+
+}  // namespace multires_bench

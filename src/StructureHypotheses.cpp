@@ -1,0 +1,173 @@
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/StructureHypotheses.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace multires_map_merge
+{
+namespace
+{
+/** Cell coordinates of a map resampled by `f` (cell centres at integers). */
+Similarity2D resampling(double f) { return Similarity2D(f, 0, {0.5 * (f - 1), 0.5 * (f - 1)}); }
+
+/** The walls of a class image at `f` times its size, blurred by a cell so
+ * that walls a cell apart still correlate. */
+cv::Mat wallImage(const cv::Mat& classes, double f)
+{
+	const cv::Mat down = f < 1 ? resampleClasses(classes, f) : classes;
+	cv::Mat walls;
+	const cv::Mat occupied = down == kOccupied;
+	occupied.convertTo(walls, CV_32F, 1.0 / 255);
+	cv::GaussianBlur(walls, walls, cv::Size(0, 0), 1.0);
+	return walls;
+}
+
+double fitFactor(const cv::Mat& img, int size)
+{
+	return std::min(1.0, double(size) / std::max(img.cols, img.rows));
+}
+
+struct Scored
+{
+	Similarity2D other_to_ref;
+	double score;
+};
+}  // namespace
+
+double dominantWallDirection(const cv::Mat& classes)
+{
+	// Walls at an angle are staircases of cells, whose gradients lean to the
+	// axes: blur well past a cell before taking directions.
+	const double f = fitFactor(classes, 768);
+	const cv::Mat down = f < 1 ? resampleClasses(classes, f) : classes;
+	cv::Mat walls;
+	const cv::Mat occupied = down == kOccupied;
+	occupied.convertTo(walls, CV_32F, 1.0 / 255);
+	cv::GaussianBlur(walls, walls, cv::Size(0, 0), 3.0);
+	cv::Mat gx, gy;
+	cv::Sobel(walls, gx, CV_32F, 1, 0);
+	cv::Sobel(walls, gy, CV_32F, 0, 1);
+	// Directions modulo 90° as angles 4θ on a circle: the weighted circular
+	// mean is the dominant direction of walls at right angles.
+	double c = 0, s = 0;
+	for (int y = 0; y < walls.rows; ++y)
+		for (int x = 0; x < walls.cols; ++x)
+		{
+			const double a = gx.at<float>(y, x), b = gy.at<float>(y, x);
+			const double m2 = a * a + b * b;
+			if (m2 < 1e-8) continue;
+			const double t4 = 4 * std::atan2(b, a);
+			c += m2 * std::cos(t4), s += m2 * std::sin(t4);
+		}
+	double d = std::atan2(s, c) / 4;
+	if (d < 0) d += M_PI / 2;
+	return d;
+}
+
+std::vector<Hypothesis> structureHypotheses(
+	const cv::Mat& ref_classes, const cv::Mat& other_classes, const StructureParams& p,
+	std::optional<double> expected_scale)
+{
+	std::vector<Hypothesis> out;
+	if (ref_classes.empty() || other_classes.empty()) return out;
+	const double f_ref = fitFactor(ref_classes, p.working_size);
+	const double f_other = fitFactor(other_classes, p.working_size);
+	const cv::Mat a = wallImage(ref_classes, f_ref), b0 = wallImage(other_classes, f_other);
+	const double b_energy = cv::sum(b0.mul(b0))[0];
+	if (cv::sum(a)[0] <= 0 || b_energy <= 0) return out;
+
+	std::vector<double> scales;  // other full cells → ref full cells
+	if (expected_scale)
+		scales = {*expected_scale};
+	else
+		for (int k = static_cast<int>(std::floor(std::log2(p.min_scale) * p.steps_per_octave));
+			 std::pow(2.0, double(k) / p.steps_per_octave) <= p.max_scale * 1.0001; ++k)
+			if (std::pow(2.0, double(k) / p.steps_per_octave) >= p.min_scale * 0.9999)
+				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
+	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
+
+	const Similarity2D other_down = resampling(f_other), ref_up = resampling(f_ref).inverse();
+	std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra_of_a;  // a and a², by canvas size
+	std::vector<Scored> found;
+	for (const double s : scales)
+		for (int k = 0; k < 4; ++k)
+		{
+			// Other's working image → ref's working image, up to a translation.
+			const Similarity2D lin(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0});
+			Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
+			for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b0.cols, 0),
+											 Eigen::Vector2d(0, b0.rows), Eigen::Vector2d(b0.cols, b0.rows)})
+				lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
+			const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
+			if (bw > 3 * p.working_size || bh > 3 * p.working_size || bw < 8 || bh < 8) continue;
+			const Similarity2D place(lin.scale, lin.yaw, -lo);  // into a bw × bh image
+			const Eigen::Matrix2d l = place.linear();
+			const cv::Mat m = (cv::Mat_<double>(2, 3) << l(0, 0), l(0, 1), place.t.x(), l(1, 0), l(1, 1), place.t.y());
+			cv::Mat b;
+			cv::warpAffine(b0, b, m, cv::Size(bw, bh), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+			const double placed_energy = cv::sum(b.mul(b))[0];
+			if (placed_energy <= 0) continue;
+
+			// C(d) = Σ a(x)·b(x − d) for every shift at once, normalised by the
+			// energy of both where they overlap (masked normalised cross-
+			// correlation): a shrunken, dense copy of the other map must not
+			// win by touching many walls.
+			const int w = cv::getOptimalDFTSize(a.cols + bw), h = cv::getOptimalDFTSize(a.rows + bh);
+			auto spectrum = [&](const cv::Mat& img) {
+				cv::Mat pad = cv::Mat::zeros(h, w, CV_32F), f;
+				img.copyTo(pad(cv::Rect(0, 0, img.cols, img.rows)));
+				cv::dft(pad, f, cv::DFT_COMPLEX_OUTPUT);
+				return f;
+			};
+			auto correlate = [&](const cv::Mat& fx, const cv::Mat& fy) {
+				cv::Mat prod, c;
+				cv::mulSpectrums(fx, fy, prod, 0, true);
+				cv::idft(prod, c, cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+				return c;
+			};
+			auto& [fa, fa2] = spectra_of_a[{w, h}];
+			if (fa.empty()) fa = spectrum(a), fa2 = spectrum(a.mul(a));
+			cv::Mat footprint;
+			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
+			cv::Mat corr = correlate(fa, spectrum(b));
+			cv::Mat a_energy = correlate(fa2, spectrum(footprint));
+			cv::max(a_energy, 1e-3 * placed_energy, a_energy);
+			cv::sqrt(a_energy * placed_energy, a_energy);
+			cv::divide(corr, a_energy, corr);
+			for (int peak = 0; peak < p.peaks_per_pose; ++peak)
+			{
+				double best;
+				cv::Point at;
+				cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
+				if (!(best > 0)) break;
+				// Shifts past the middle are negative (the FFT wraps).
+				const double dx = at.x > w - bw ? at.x - w : at.x, dy = at.y > h - bh ? at.y - h : at.y;
+				const Similarity2D working(place.scale, place.yaw, place.t + Eigen::Vector2d(dx, dy));
+				found.push_back({ref_up.compose(working).compose(other_down), best});
+				cv::circle(corr, at, 6, cv::Scalar(0), cv::FILLED);
+			}
+		}
+	std::sort(found.begin(), found.end(), [](const Scored& x, const Scored& y) { return x.score > y.score; });
+	for (const auto& f : found)
+	{
+		if (static_cast<int>(out.size()) >= p.max_hypotheses) break;
+		const bool seen = std::any_of(out.begin(), out.end(), [&](const Hypothesis& h) {
+			return std::abs(std::log(h.other_to_ref.scale / f.other_to_ref.scale)) < 0.05 &&
+				std::abs(wrapToPi(h.other_to_ref.yaw - f.other_to_ref.yaw)) < 0.1 &&
+				(h.other_to_ref.t - f.other_to_ref.t).norm() < 10 / f_ref;
+		});
+		if (seen) continue;
+		Hypothesis h;
+		h.other_to_ref = f.other_to_ref;
+		h.inliers = static_cast<int>(std::lround(1000 * f.score));
+		h.ref_level = h.other_level = -1;  // not from a pyramid level pair
+		out.push_back(h);
+	}
+	return out;
+}
+
+}  // namespace multires_map_merge
