@@ -86,7 +86,12 @@ std::optional<Similarity2D> ransacSimilarity(
 	countInliers(*best, &mask);
 	Eigen::Matrix2Xd src(2, best_count), dst(2, best_count);
 	for (size_t k = 0, c = 0; k < n; ++k)
-		if (mask[k]) src.col(c) << from[k].x, from[k].y, dst.col(c) << to[k].x, to[k].y, ++c;
+		if (mask[k])
+		{
+			src.col(c) = Eigen::Vector2d(from[k].x, from[k].y);
+			dst.col(c) = Eigen::Vector2d(to[k].x, to[k].y);
+			++c;
+		}
 	const Similarity2D refit = Similarity2D::fromMatrix(Eigen::Matrix3d(Eigen::umeyama(src, dst, true)));
 	std::vector<uchar> refit_mask(n, 0);
 	if (refit.isFinite() && refit.scale >= min_scale && refit.scale <= max_scale &&

@@ -129,8 +129,8 @@ Chance chanceSupport(
 	centre = other_to_ref(centre / double(other_points.size()));
 	const double shift = shift_coarse * std::max(1.0, other_to_ref.scale);
 	std::vector<Similarity2D> moves;
-	for (const Eigen::Vector2d d : {Eigen::Vector2d(shift, 0), Eigen::Vector2d(-shift, 0), Eigen::Vector2d(0, shift),
-									Eigen::Vector2d(0, -shift)})
+	const Eigen::Vector2d shifts[] = {{shift, 0}, {-shift, 0}, {0, shift}, {0, -shift}};
+	for (const Eigen::Vector2d& d : shifts)
 		moves.emplace_back(1, 0, d);
 	for (const double deg : {turn_deg, -turn_deg})
 	{
