@@ -175,6 +175,7 @@ struct PairResult
 	std::string message;
 	double rmse = NAN, yaw_err = NAN, scale_err_pct = NAN, implied_err_pct = NAN;
 	double overlap = NAN, true_overlap = NAN, confidence = 0, seconds = 0;
+	double floor_rmse = NAN;  //!< TsICP started at the truth: what the rendering allows
 	std::map<std::string, double> stages;
 	// MRPT
 	bool mrpt_ran = false, mrpt_correct = false;
@@ -235,6 +236,13 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 		p.correct = p.rmse <= 2;
 	}
 	p.true_overlap = trueOverlap(metricEdges(ref), other_edges, truth, coarse);
+	{
+		const Similarity2D truth_cells = ref.cellToMapFrame().inverse().compose(truth).compose(other.cellToMapFrame());
+		const TsICPResult at_truth = runTsICP(
+			edgePoints(toClassImage(ref.grid)), edgePoints(toClassImage(other.grid)), truth_cells, aligner.options.icpParams());
+		p.floor_rmse = pointRmse(ref.cellToMapFrame().compose(at_truth.transform).compose(other.cellToMapFrame().inverse()),
+								 truth, other_edges) / coarse;
+	}
 	const auto cm_of = [](double res) { return std::to_string(std::lround(res * 100)) + "cm"; };
 	writeCandidates(log, set + "_" + cm_of(rr), cm_of(ro) + "_yaw" + std::to_string(std::lround(yaw)), true, false, r,
 					[&](const Similarity2D& cells) {
@@ -260,7 +268,7 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 	}
 	std::cout << std::fixed << std::setprecision(3) << set << " " << log << " " << rr * 100 << "cm vs "
 			  << ro * 100 << "cm yaw " << yaw << ": " << (p.correct ? "OK" : (p.merged ? "WRONG" : "not merged"))
-			  << " rmse " << p.rmse << " coarse cells, " << p.seconds << " s";
+			  << " rmse " << p.rmse << " coarse cells (from the truth " << p.floor_rmse << "), " << p.seconds << " s";
 	if (with_mrpt)
 		std::cout << " | MRPT " << (p.mrpt_correct ? "OK" : p.mrpt_why) << " " << p.mrpt_seconds << " s";
 	std::cout << std::endl;
@@ -705,6 +713,41 @@ std::vector<HalmstadRun> runHalmstad(
 	return runs;
 }
 
+/** The accuracy matrices alone (no MRPT, no report): for work on accuracy. */
+int runAccuracySets(const std::string& list)
+{
+	const std::vector<double> res_all = {0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.10};
+	std::stringstream in(list);
+	for (std::string set; std::getline(in, set, ',');)
+	{
+		std::vector<PairResult> rs;
+		if (set == "resolution")
+			for (const double rr : res_all)
+				for (const double ro : res_all) rs.push_back(runPair(set, "fr079", rr, ro, 0, false));
+		else if (set == "other-logs")
+			for (const std::string log : {"intel", "fr101", "orebro", "fhw", "belgioioso"})
+				for (const double rr : {0.02, 0.05, 0.10})
+					for (const double ro : {0.02, 0.05, 0.10}) rs.push_back(runPair(set, log, rr, ro, 0, false));
+		else if (set == "rotation")
+			for (const double yaw : {0, 90, 180, 270, 137})
+				for (const double ro : res_all) rs.push_back(runPair(set, "fr079", 0.02, ro, yaw, false));
+		else
+		{
+			std::cerr << "multires_bench: unknown set '" << set << "'\n";
+			return 2;
+		}
+		std::vector<double> ok, floor;
+		for (const auto& r : rs)
+		{
+			if (r.correct) ok.push_back(r.rmse);
+			floor.push_back(r.floor_rmse);
+		}
+		std::cout << set << ": " << ok.size() << "/" << rs.size() << " right, median RMSE " << median(ok)
+				  << " coarse cells; TsICP from the truth " << median(floor) << std::endl;
+	}
+	return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -721,6 +764,9 @@ int main(int argc, char** argv)
 		"", "halmstad-only", "only the real-independent-maps section, on these sites (e.g. E5,HIH)", false, "", "SITES", cmd);
 	TCLAP::ValueArg<int> negatives_arg(
 		"", "halmstad-negatives", "cross-site negatives per map (with --halmstad-only)", false, 8, "N", cmd);
+	TCLAP::ValueArg<std::string> sets_arg(
+		"", "sets", "only these accuracy sets (resolution, other-logs, rotation), printing their medians", false, "",
+		"SETS", cmd);
 	TCLAP::ValueArg<std::string> mrpt_child("", "mrpt-align", "internal: MRPT's aligner in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_ref("", "scaling-align", "internal: align in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_other("", "scaling-other", "internal: with --scaling-align", false, "", "OTHER", cmd);
@@ -779,6 +825,8 @@ int main(int argc, char** argv)
 					  << false_merges << "/" << runs.size() - pos << " false merges\n";
 			return 0;
 		}
+		if (sets_arg.isSet())
+			return runAccuracySets(sets_arg.getValue());
 		const auto started = std::chrono::steady_clock::now();
 		std::vector<PairResult> all;
 
