@@ -43,6 +43,72 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 	return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
+std::string fleetJson(
+	const FleetResult& r, const std::vector<std::string>& names, size_t reference, double runtime_s,
+	const std::string& error)
+{
+	auto name = [&](int m) { return m >= 0 && size_t(m) < names.size() ? names[m] : std::string(); };
+	nlohmann::ordered_json maps = nlohmann::ordered_json::array();
+	for (size_t m = 0; m < r.maps.size(); ++m)
+	{
+		if (m == reference) continue;
+		const FleetPlacement& p = r.maps[m];
+		maps.push_back({
+			{"file", name(int(m))},
+			{"success", p.placed},
+			{"transform", p.placed ? transformJson(p.in_reference) : nlohmann::ordered_json()},
+			{"confidence", num(p.confidence)},
+			{"placed_through", p.parent >= 0 && size_t(p.parent) != reference ? name(p.parent) : ""},
+			{"error", p.placed ? "" : p.message},
+		});
+	}
+	nlohmann::ordered_json pairs = nlohmann::ordered_json::array();
+	for (const FleetEdge& e : r.edges)
+		pairs.push_back({{"ref", name(int(e.to))},
+						 {"other", name(int(e.from))},
+						 {"merged", e.merged && !e.dropped},
+						 {"confidence", num(e.confidence)},
+						 {"transform", e.merged ? transformJson(e.from_to_to) : nlohmann::ordered_json()},
+						 {"message", e.message}});
+	const nlohmann::ordered_json j = {
+		{"success", error.empty() && r.allPlaced()},
+		{"reference", name(int(reference))},
+		{"maps", maps},
+		{"pairs_aligned", r.pairs_aligned},
+		{"pairs_skipped", r.pairs_skipped},
+		{"pairs", pairs},
+		{"runtime_s", num(runtime_s)},
+		{"error", error},
+	};
+	return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+}
+
+cv::Mat fleetOverlayImage(const std::vector<cv::Mat>& classes)
+{
+	// Distinct, colour-blind-friendly hues (BGR), the reference's first.
+	static const cv::Scalar palette[] = {
+		{178, 114, 0}, {0, 94, 213}, {115, 158, 0}, {167, 121, 204}, {0, 159, 230}, {233, 180, 86}, {66, 228, 240}, {90, 90, 90}};
+	cv::Size size;
+	for (const auto& c : classes)
+		if (!c.empty()) size = c.size();
+	CV_Assert(size.area() > 0);
+	cv::Mat out(size, CV_8UC3, cv::Scalar(160, 160, 160));
+	cv::Mat occupied_count = cv::Mat::zeros(size, CV_8UC1);
+	for (const auto& c : classes)
+		if (!c.empty())
+		{
+			CV_Assert(c.size() == size && c.type() == CV_8UC1);
+			out.setTo(cv::Scalar(255, 255, 255), c == kFree);
+			cv::add(occupied_count, (c == kOccupied) / 255, occupied_count);
+		}
+	for (size_t m = 0; m < classes.size(); ++m)
+		if (!classes[m].empty()) out.setTo(palette[m % 8], (classes[m] == kOccupied) & (occupied_count == 1));
+	out.setTo(cv::Scalar(0, 0, 0), occupied_count >= 2);  // black: walls two maps agree on
+	cv::Mat flipped;
+	cv::flip(out, flipped, 0);  // +y up, like forDisplay()
+	return flipped;
+}
+
 cv::Mat overlayImage(const cv::Mat& ref, const cv::Mat& other)
 {
 	CV_Assert(ref.size() == other.size() && ref.type() == CV_8UC1 && other.type() == CV_8UC1);

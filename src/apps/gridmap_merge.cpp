@@ -1,8 +1,11 @@
-// gridmap-merge: aligns and fuses two saved grid maps whose resolutions may
-// differ (or be wrongly stated), or the last nav_msgs/OccupancyGrid on two
-// topics of a rosbag. Exit codes: 0 merged, 1 no confident alignment (only
-// the JSON is written), 2 bad input or usage.
+// gridmap-merge: aligns and fuses saved grid maps whose resolutions may
+// differ (or be wrongly stated), or the last nav_msgs/OccupancyGrid on
+// topics of a rosbag: two maps, or a fleet of three or more placed in the
+// first one's frame. Exit codes: 0 merged (every map placed), 1 no confident
+// alignment (two maps: only the JSON is written; a fleet: the maps placed
+// are merged, the JSON names the others), 2 bad input or usage.
 #include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridMapFusion.h>
 #include <multires_map_merge/MapIO.h>
 #include <multires_map_merge/MergeReport.h>
@@ -45,22 +48,28 @@ double outputResolution(const std::string& spec, double ref_res, double other_re
 	throw UsageError("--output-resolution must be 'reference', 'finest' or metres > 0, not '" + spec + "'");
 }
 
-/** Two maps, each a grid in its exact frame: a map_server origin, a ROS
- * message's info.origin (identity for .gridmap files). */
+/** The maps, each a grid in its exact frame (a map_server origin, a ROS
+ * message's info.origin; identity for .gridmap files), and their names. */
 struct Inputs
 {
-	GridInFrame ref, other;
+	std::vector<GridInFrame> maps;
+	std::vector<std::string> names;
 };
 
-Inputs fromFiles(const std::string& ref, const std::string& other, double simplemap_res)
+Inputs fromFiles(const std::vector<std::string>& files, double simplemap_res)
 {
-	return {loadGridMap(ref, simplemap_res), loadGridMap(other, simplemap_res)};
+	Inputs in;
+	for (const auto& f : files) in.maps.push_back(loadGridMap(f, simplemap_res)), in.names.push_back(f);
+	return in;
 }
 
 Inputs fromBag(const std::string& bag, const std::vector<std::string>& topics)
 {
-	return {ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[0]).back(), topics[0]),
-			ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, topics[1]).back(), topics[1])};
+	Inputs in;
+	for (const auto& t : topics)
+		in.maps.push_back(ros1::gridFromMsg(ros1::occupancyGridsInBag(bag, t).back(), t)),
+			in.names.push_back(bag + ":" + t);
+	return in;
 }
 
 /** TCLAP takes one value per flag: "--topics A B" becomes "--topics A --topics B". */
@@ -82,6 +91,56 @@ void writeText(const std::string& path, const std::string& text)
 	f << text;
 	if (!f) throw MapIOError("'" + path + "': cannot write");
 }
+
+/** Three or more maps: every map placed in REF's frame through its most
+ * confident chain of pairwise alignments (FleetMerge.h). Exit 0 when every
+ * map is placed, 1 when one is not (the merged map of those placed is still
+ * written, and the JSON says which and why). */
+int mergeFleet(
+	const Inputs& in, const CScalingGridMapAligner& aligner, const std::string& outres, const std::string& json,
+	const std::string& out, const std::string& png, mrpt::system::CTicTac& clock)
+{
+	const FleetResult r = placeFleet(in.maps, 0, aligner);
+	std::cout << "aligned " << r.pairs_aligned << " pairs, skipped " << r.pairs_skipped << "\n";
+	double finest = in.maps[0].grid.getResolution();
+	for (size_t m = 1; m < in.maps.size(); ++m)
+	{
+		const FleetPlacement& p = r.maps[m];
+		if (!p.placed)
+		{
+			std::cout << "NOT PLACED " << in.names[m] << ": " << p.message << "\n";
+			continue;
+		}
+		const double implied = in.maps[m].grid.getResolution() * p.in_reference.scale;
+		finest = std::min(finest, implied);
+		std::cout << "placed " << in.names[m] << " (confidence " << p.confidence
+				  << (p.parent > 0 ? ", through " + in.names[p.parent] : std::string()) << "): x "
+				  << p.in_reference.t.x() << " m, y " << p.in_reference.t.y() << " m, yaw "
+				  << p.in_reference.yaw * 180 / M_PI << " deg, scale " << p.in_reference.scale
+				  << "; implied resolution " << implied << " m\n";
+	}
+	const bool any_placed = std::any_of(r.maps.begin() + 1, r.maps.end(), [](const FleetPlacement& p) { return p.placed; });
+	if (any_placed && (!out.empty() || !png.empty()))
+	{
+		const double res = outputResolution(outres, in.maps[0].grid.getResolution(), finest);
+		const FusedFleet fused = fuseFleet(in.maps, r, 0, res);
+		std::cout << "  merged map: " << fused.merged.grid.getSizeX() << "x" << fused.merged.grid.getSizeY()
+				  << " cells at " << fused.merged.grid.getResolution() << " m\n";
+		if (!out.empty())
+		{
+			const std::string note = saveGridMap(fused.merged, out);
+			std::cout << "  wrote " << out << "\n";
+			if (!note.empty()) std::cerr << "gridmap-merge: note: " << note << "\n";
+		}
+		if (!png.empty())
+		{
+			if (!cv::imwrite(png, fleetOverlayImage(fused.classes))) throw MapIOError("'" + png + "': cannot write PNG");
+			std::cout << "  wrote " << png << "\n";
+		}
+	}
+	if (!json.empty()) writeText(json, fleetJson(r, in.names, 0, clock.Tac()));
+	return r.allPlaced() ? kMerged : kNotMerged;
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -93,19 +152,19 @@ int main(int argc, char** argv)
 		' ', "0.1.0");
 	TCLAP::UnlabeledMultiArg<std::string> maps_arg(
 		"MAPS",
-		"REF OTHER: the reference map and the map to align onto it; each .gridmap[.gz], "
+		"REF OTHER [OTHER ...]: the reference map and the maps to place in its frame; each .gridmap[.gz], "
 		"map_server .yaml or .simplemap[.gz] (not with --bag)",
-		false, "REF OTHER", cmd);
+		false, "REF OTHER [OTHER ...]", cmd);
 	TCLAP::ValueArg<std::string> bag_arg(
 		"", "bag", "merge the last nav_msgs/OccupancyGrid on two topics of this rosbag", false, "",
 		"FILE.bag", cmd);
 	TCLAP::MultiArg<std::string> topics_arg(
-		"", "topics", "with --bag: REF_TOPIC OTHER_TOPIC", false, "TOPIC", cmd);
+		"", "topics", "with --bag: REF_TOPIC OTHER_TOPIC [OTHER_TOPIC ...]", false, "TOPIC", cmd);
 	TCLAP::ValueArg<std::string> json_arg("", "json", "write the result as JSON", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> out_arg(
 		"", "out", "write the merged map (.gridmap.gz or .yaml + .pgm)", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> png_arg(
-		"", "png", "write an overlay PNG (black both, blue REF only, red OTHER only)", false, "", "FILE", cmd);
+		"", "png", "write an overlay PNG (black both, blue REF only, red OTHER only; a colour per map for 3+)", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> config_arg(
 		"", "config", "aligner parameters, section [aligner] of an MRPT ini file", false, "", "FILE.ini", cmd);
 	TCLAP::SwitchArg metadata_arg(
@@ -128,12 +187,12 @@ int main(int argc, char** argv)
 			if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
 		const bool bag_mode = bag_arg.isSet();
 		if (bag_mode && !maps_arg.getValue().empty())
-			throw UsageError("give either --bag FILE --topics A B or two map files, not both");
-		if (!bag_mode && maps_arg.getValue().size() != 2)
-			throw UsageError("give two map files (REF OTHER), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
+			throw UsageError("give either --bag FILE --topics A B or map files, not both");
+		if (!bag_mode && maps_arg.getValue().size() < 2)
+			throw UsageError("give two or more map files (REF OTHER [OTHER ...]), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
 		if (!bag_mode && topics_arg.isSet()) throw UsageError("--topics needs --bag");
-		if (bag_mode && topics_arg.getValue().size() != 2)
-			throw UsageError("--bag needs --topics REF_TOPIC OTHER_TOPIC (two topics)");
+		if (bag_mode && topics_arg.getValue().size() < 2)
+			throw UsageError("--bag needs --topics REF_TOPIC OTHER_TOPIC [OTHER_TOPIC ...] (two or more topics)");
 
 		CScalingGridMapAligner aligner;
 		if (config_arg.isSet())
@@ -150,25 +209,32 @@ int main(int argc, char** argv)
 			!hasSuffix(out_arg.getValue(), ".gridmap") && !hasSuffix(out_arg.getValue(), ".yaml"))
 			throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
 
-		const std::string ref_name = bag_mode ? bag_arg.getValue() + ":" + topics_arg.getValue()[0]
-											  : maps_arg.getValue()[0];
-		const std::string other_name = bag_mode ? bag_arg.getValue() + ":" + topics_arg.getValue()[1]
-												: maps_arg.getValue()[1];
 		const Inputs in = bag_mode ? fromBag(bag_arg.getValue(), topics_arg.getValue())
-								   : fromFiles(ref_name, other_name, smres_arg.getValue());
+								   : fromFiles(maps_arg.getValue(), smres_arg.getValue());
+		const std::string& ref_name = in.names[0];
 		// A .gridmap holds no rotation: say so before any work.
-		if (in.ref.origin.yaw != 0 && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
+		if (in.maps[0].origin.yaw != 0 && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
 			throw UsageError(
 				"--out: " + ref_name + " has a rotated origin, which only a .yaml map can hold; save as .yaml");
-		const auto& ref = in.ref.grid;
-		const auto& other = in.other.grid;
+		if (in.maps.size() > 2)
+		{
+			for (size_t m = 0; m < in.maps.size(); ++m)
+				std::cout << (m ? "OTHER " : "REF   ") << in.names[m] << ": " << in.maps[m].grid.getSizeX() << "x"
+						  << in.maps[m].grid.getSizeY() << " cells, stated " << in.maps[m].grid.getResolution()
+						  << " m\n";
+			return mergeFleet(in, aligner, outres_arg.getValue(), json_arg.getValue(), out_arg.getValue(),
+							  png_arg.getValue(), clock);
+		}
+		const std::string& other_name = in.names[1];
+		const auto& ref = in.maps[0].grid;
+		const auto& other = in.maps[1].grid;
 		std::cout << "REF   " << ref_name << ": " << ref.getSizeX() << "x" << ref.getSizeY()
 				  << " cells, stated " << ref.getResolution() << " m\n"
 				  << "OTHER " << other_name << ": " << other.getSizeX() << "x" << other.getSizeY()
 				  << " cells, stated " << other.getResolution() << " m\n";
 
 		// Between the maps' frames, exact for any origin.
-		r = aligner.alignScaled(in.ref, in.other);
+		r = aligner.alignScaled(in.maps[0], in.maps[1]);
 		double res = 0;
 		if (r.success) res = outputResolution(outres_arg.getValue(), ref.getResolution(), r.implied_resolution_other);
 		if (!r.success)
@@ -185,7 +251,7 @@ int main(int argc, char** argv)
 
 		if (out_arg.isSet() || png_arg.isSet())
 		{
-			const FusedMap fused = fuseGridMaps(in.ref, in.other, r.metric, res);
+			const FusedMap fused = fuseGridMaps(in.maps[0], in.maps[1], r.metric, res);
 			std::cout << "  merged map: " << fused.merged.grid.getSizeX() << "x" << fused.merged.grid.getSizeY()
 					  << " cells at " << fused.merged.grid.getResolution() << " m\n";
 			if (out_arg.isSet())

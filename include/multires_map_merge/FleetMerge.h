@@ -1,0 +1,81 @@
+#pragma once
+// N maps into one (a fleet). Pairwise scaling alignments form a graph of
+// confident similarities; every map is placed through its most confident
+// path from the reference (maximum spanning tree, a path as sure as its
+// weakest edge); an aligned pair that contradicts the tree around a cycle
+// drops the weakest edge of that cycle; the placed maps are fused with the
+// two-map cell rule. A map that nothing confident connects is reported by
+// name as not placed: never dropped silently, never placed on a guess.
+#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/GridInFrame.h>
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace multires_map_merge
+{
+/** One aligned pair: `from`'s frame placed in `to`'s (between map frames). */
+struct FleetEdge
+{
+	size_t from = 0, to = 0;
+	bool merged = false;  //!< the aligner was confident
+	Similarity2D from_to_to;
+	double confidence = 0;
+	std::string message;  //!< the aligner's
+	bool dropped = false;  //!< contradicted the others around a cycle
+};
+
+struct FleetPlacement
+{
+	bool placed = false;
+	/** The pose (with scale) of this map's frame in the reference's frame. */
+	Similarity2D in_reference;
+	/** The weakest edge on its path (1 for the reference itself). */
+	double confidence = 0;
+	int parent = -1;  //!< the map it was placed through (-1: reference or none)
+	std::string message;  //!< how it was placed, or why not
+};
+
+struct FleetParams
+{
+	/** Pairs aligned at once (0: one per hardware thread). */
+	unsigned threads = 0;
+	/** A map placed this surely needs no more pairs: the pairs between
+	 * settled maps are skipped. */
+	double settled_confidence = 0.95;
+	/** A cycle whose composed transform moves a map's corners by more than
+	 * this many cells of the coarser map (RMS) is contradictory. */
+	double cycle_tolerance_cells = 3.0;
+};
+
+struct FleetResult
+{
+	std::vector<FleetPlacement> maps;  //!< one per input, in input order
+	std::vector<FleetEdge> edges;  //!< every aligned pair
+	size_t pairs_aligned = 0, pairs_skipped = 0;
+	bool allPlaced() const;
+};
+
+/** Places every map in `maps[reference]`'s frame. Throws std::invalid_argument
+ * on fewer than two maps or a reference out of range. */
+FleetResult placeFleet(
+	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
+	const FleetParams& params = {});
+
+struct FusedFleet
+{
+	/** In the reference map's frame, on the reference grid's lattice. */
+	GridInFrame merged;
+	/** Each input's classes sampled on the merged grid (empty if not placed):
+	 * what the overlay PNG colours. */
+	std::vector<cv::Mat> classes;
+};
+
+/** Fuses every placed map (the cell rule of fuseGridMaps) at
+ * `output_resolution`. Throws MergedMapTooLarge past `max_cells`. */
+FusedFleet fuseFleet(
+	const std::vector<GridInFrame>& maps, const FleetResult& placement, size_t reference,
+	double output_resolution, size_t max_cells = size_t(1) << 28);
+
+}  // namespace multires_map_merge

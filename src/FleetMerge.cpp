@@ -1,0 +1,250 @@
+#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GridMapFusion.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace multires_map_merge
+{
+bool FleetResult::allPlaced() const
+{
+	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
+}
+
+namespace
+{
+using PairList = std::vector<std::pair<size_t, size_t>>;  // (to, from): `from` aligned onto `to`
+
+/** Aligns each pair (to, from) on a small pool of threads, each with its own
+ * aligner (same options): the aligner keeps logger state. */
+std::vector<FleetEdge> alignPairs(
+	const std::vector<GridInFrame>& maps, const PairList& pairs, const CScalingGridMapAligner& aligner,
+	unsigned threads)
+{
+	std::vector<FleetEdge> out(pairs.size());
+	std::atomic<size_t> next{0};
+	auto work = [&]() {
+		CScalingGridMapAligner local;
+		local.options = aligner.options;
+		local.setMinLoggingLevel(aligner.getMinLoggingLevel());
+		for (size_t k; (k = next++) < pairs.size();)
+		{
+			FleetEdge& e = out[k];
+			e.to = pairs[k].first, e.from = pairs[k].second;
+			try
+			{
+				const auto r = local.alignScaled(maps[e.to], maps[e.from]);
+				e.merged = r.success;
+				e.from_to_to = r.metric;
+				e.confidence = r.success ? r.confidence : 0.0;
+				e.message = r.message;
+			}
+			catch (const std::exception& ex)
+			{
+				e.message = ex.what();
+			}
+		}
+	};
+	if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+	const size_t n = std::min<size_t>(threads, pairs.size());
+	std::vector<std::thread> pool;
+	for (size_t t = 1; t < n; ++t) pool.emplace_back(work);
+	work();
+	for (auto& t : pool) t.join();
+	return out;
+}
+
+/** RMS over `from`'s grid corners of where two transforms of its frame put
+ * them, in cells of the coarser map of the pair. */
+double disagreementCells(const GridInFrame& from, const GridInFrame& to, const Similarity2D& a, const Similarity2D& b)
+{
+	const Similarity2D cells = from.cellToMapFrame();
+	const double w = from.grid.getSizeX() - 1, h = from.grid.getSizeY() - 1;
+	double se = 0;
+	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
+	{
+		const Eigen::Vector2d p = cells(c);
+		se += (a(p) - b(p)).squaredNorm();
+	}
+	const double coarse = std::max<double>(to.grid.getResolution(), from.grid.getResolution() * a.scale);
+	return std::sqrt(se / 4) / coarse;
+}
+
+struct Tree
+{
+	std::vector<FleetPlacement> maps;
+	std::vector<int> via_edge;  // the tree edge placing each map (-1: none)
+};
+
+/** Maximum spanning tree from the reference over the confident, kept edges
+ * (Prim): each map joins through the most confident edge to the placed
+ * part, so its path is the most confident one (as sure as its weakest edge). */
+Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edges)
+{
+	Tree t;
+	t.maps.assign(n, {});
+	t.via_edge.assign(n, -1);
+	t.maps[reference].placed = true;
+	t.maps[reference].confidence = 1;
+	t.maps[reference].message = "reference";
+	for (;;)
+	{
+		int best = -1;
+		for (size_t k = 0; k < edges.size(); ++k)
+		{
+			const FleetEdge& e = edges[k];
+			if (!e.merged || e.dropped || t.maps[e.from].placed == t.maps[e.to].placed) continue;
+			if (best < 0 || e.confidence > edges[best].confidence) best = static_cast<int>(k);
+		}
+		if (best < 0) break;
+		const FleetEdge& e = edges[best];
+		const bool from_new = !t.maps[e.from].placed;
+		const size_t added = from_new ? e.from : e.to, anchor = from_new ? e.to : e.from;
+		FleetPlacement& p = t.maps[added];
+		p.placed = true;
+		p.in_reference = from_new ? t.maps[anchor].in_reference.compose(e.from_to_to)
+								  : t.maps[anchor].in_reference.compose(e.from_to_to.inverse());
+		p.confidence = std::min(t.maps[anchor].confidence, e.confidence);
+		p.parent = static_cast<int>(anchor);
+		std::ostringstream how;
+		how << "placed through map " << anchor << " (pair confidence " << e.confidence << ")";
+		p.message = how.str();
+		t.via_edge[added] = best;
+	}
+	return t;
+}
+
+/** Tree edges on the path from `a` to the reference. */
+std::vector<int> pathEdges(const Tree& t, size_t a)
+{
+	std::vector<int> out;
+	for (int m = static_cast<int>(a); t.via_edge[m] >= 0; m = t.maps[m].parent) out.push_back(t.via_edge[m]);
+	return out;
+}
+
+/** Builds the tree; while a kept non-tree edge contradicts it, drops the
+ * weakest edge of that cycle and rebuilds. */
+Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge>& edges, double tol)
+{
+	for (;;)
+	{
+		Tree t = spanningTree(maps.size(), reference, edges);
+		int contradicted = -1;
+		for (size_t k = 0; k < edges.size() && contradicted < 0; ++k)
+		{
+			const FleetEdge& e = edges[k];
+			if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
+			if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
+			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
+			if (disagreementCells(maps[e.from], maps[e.to], predicted, e.from_to_to) > tol) contradicted = int(k);
+		}
+		if (contradicted < 0) return t;
+		// The cycle: this edge and both paths to the reference (their common
+		// part cancels, but the weakest edge is what we drop either way, and a
+		// shared edge is as suspect as any).
+		std::vector<int> cycle = pathEdges(t, edges[contradicted].from);
+		for (int k : pathEdges(t, edges[contradicted].to)) cycle.push_back(k);
+		cycle.push_back(contradicted);
+		const int weakest = *std::min_element(cycle.begin(), cycle.end(), [&](int a, int b) {
+			return edges[a].confidence < edges[b].confidence;
+		});
+		edges[weakest].dropped = true;
+		std::ostringstream why;
+		why << "dropped: contradicts the other alignments around a cycle (" << edges[weakest].message << ")";
+		edges[weakest].message = why.str();
+	}
+}
+}  // namespace
+
+FleetResult placeFleet(
+	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
+	const FleetParams& params)
+{
+	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
+	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
+	const size_t n = maps.size();
+	FleetResult out;
+	std::map<std::pair<size_t, size_t>, bool> aligned;  // unordered pair → done
+	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+
+	// Round 1: everything against the reference (the two-map case exactly).
+	PairList todo;
+	for (size_t k = 0; k < n; ++k)
+		if (k != reference) todo.emplace_back(reference, k);
+	Tree tree;
+	while (!todo.empty())
+	{
+		for (auto& e : alignPairs(maps, todo, aligner, params.threads)) out.edges.push_back(std::move(e));
+		for (const auto& [a, b] : todo) aligned[key(a, b)] = true;
+		out.pairs_aligned += todo.size();
+		tree = consistentTree(maps, reference, out.edges, params.cycle_tolerance_cells);
+		// Next round: the pairs that can still matter, those with a map that is
+		// not yet placed surely (a better path, or a first one, may go through
+		// any other map). Placed maps go first: they can carry a new one.
+		todo.clear();
+		auto settled = [&](size_t m) { return tree.maps[m].placed && tree.maps[m].confidence >= params.settled_confidence; };
+		for (size_t a = 0; a < n; ++a)
+			for (size_t b = a + 1; b < n; ++b)
+			{
+				if (aligned.count(key(a, b)) || (settled(a) && settled(b))) continue;
+				const bool b_first = tree.maps[b].placed && !tree.maps[a].placed;
+				todo.emplace_back(b_first ? b : a, b_first ? a : b);
+			}
+	}
+	out.pairs_skipped = n * (n - 1) / 2 - out.pairs_aligned;
+	out.maps = tree.maps;
+	for (size_t m = 0; m < n; ++m)
+	{
+		if (out.maps[m].placed) continue;
+		// Say why: the most confident pair this map had, and its reason.
+		const FleetEdge* best = nullptr;
+		for (const auto& e : out.edges)
+			if ((e.from == m || e.to == m) && (!best || e.confidence > best->confidence)) best = &e;
+		std::ostringstream why;
+		why << "not placed: no confident alignment connects it to the reference";
+		if (best)
+			why << " (closest: map " << (best->from == m ? best->to : best->from) << ", " << best->message << ")";
+		out.maps[m].message = why.str();
+	}
+	return out;
+}
+
+FusedFleet fuseFleet(
+	const std::vector<GridInFrame>& maps, const FleetResult& placement, size_t reference, double output_resolution,
+	size_t max_cells)
+{
+	if (placement.maps.size() != maps.size() || reference >= maps.size())
+		throw std::invalid_argument("fuseFleet: placement does not match the maps");
+	// One fusion per placed map into the growing result: each output cell
+	// keeps the cell rule (occupied if any, else free if any, else unknown).
+	GridInFrame merged = fuseGridMaps(maps[reference], maps[reference], Similarity2D(), output_resolution, max_cells).merged;
+	for (size_t m = 0; m < maps.size(); ++m)
+		if (m != reference && placement.maps[m].placed)
+			merged = fuseGridMaps(merged, maps[m], placement.maps[m].in_reference, output_resolution, max_cells).merged;
+	FusedFleet out;
+	out.classes.resize(maps.size());
+	for (size_t m = 0; m < maps.size(); ++m)
+	{
+		if (!placement.maps[m].placed) continue;
+		const FusedMap f = fuseGridMaps(merged, maps[m], placement.maps[m].in_reference, output_resolution, max_cells);
+		// Both grids lie on merged's lattice in one frame; sub-cell sampling at
+		// the border may add a cell row that the picture can do without.
+		const double res = merged.grid.getResolution();
+		const int ox = static_cast<int>(std::lround((f.merged.grid.getXMin() - merged.grid.getXMin()) / res));
+		const int oy = static_cast<int>(std::lround((f.merged.grid.getYMin() - merged.grid.getYMin()) / res));
+		cv::Mat classes(int(merged.grid.getSizeY()), int(merged.grid.getSizeX()), CV_8UC1, cv::Scalar(kUnknown));
+		const cv::Rect into = cv::Rect(ox, oy, f.other_classes.cols, f.other_classes.rows) & cv::Rect(0, 0, classes.cols, classes.rows);
+		if (into.area() > 0) f.other_classes(into - cv::Point(ox, oy)).copyTo(classes(into));
+		out.classes[m] = classes;
+	}
+	out.merged = std::move(merged);
+	return out;
+}
+
+}  // namespace multires_map_merge

@@ -1,0 +1,215 @@
+// A fleet: N maps into one (FleetMerge.h), through map_server files as users
+// feed them. Four robots of one building (fr079) at 5 / 3 / 8 / 4 cm in their
+// own frames with off-lattice origins, where the fourth robot's part of the
+// run overlaps only the third's; plus a robot of another building (intel),
+// which must stay out, named.
+#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/MapIO.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+#include <memory>
+
+#include "cli_run.h"
+#include "test_data.h"
+
+using namespace multires_map_merge;
+using namespace multires_map_merge::test;
+namespace fs = std::filesystem;
+
+namespace
+{
+struct Robot
+{
+	std::string file;
+	double resolution;
+	Similarity2D truth;  //!< its map frame → the reference's map frame
+};
+
+struct Fleet
+{
+	std::vector<Robot> robots;  // [0] the reference; the last one another building
+	std::vector<GridInFrame> maps;  // loaded back from the files
+};
+
+std::string tmpDir()
+{
+	const fs::path d = fs::temp_directory_path() / ("mmm_test_fleet_" + std::to_string(getpid()));
+	fs::create_directories(d);
+	return d.string();
+}
+
+struct RemoveTmpDir : ::testing::Environment
+{
+	void TearDown() override { fs::remove_all(tmpDir()); }
+};
+const auto* const kRemoveTmpDir = ::testing::AddGlobalTestEnvironment(new RemoveTmpDir);
+
+/** Renders a robot's share [begin, end) of a run, in `frame`, written as a
+ * map_server file with its origin off the lattice by (dx, dy) cells. With
+ * `unseen_by`, the cells within a metre of what that robot saw are made
+ * unknown: a robot that explored only beyond it. */
+Robot writeRobot(
+	const ScanSequence& s, double begin, double end, double res, const mrpt::poses::CPose2D& frame, double dx,
+	double dy, const std::string& name, const GridInFrame* unseen_by = nullptr)
+{
+	const size_t n = s.size();
+	Robot r{tmpDir() + "/" + name + ".yaml", res, Similarity2D(1, frame.phi(), {frame.x(), frame.y()})};
+	GridInFrame map = renderGridOffLattice(s, size_t(begin * n), size_t(end * n), res, frame, dx * res, dy * res);
+	if (unseen_by)  // unseen_by's map frame is the run's (the reference's)
+	{
+		cv::Mat seen = toClassImage(unseen_by->grid) != kUnknown;
+		const int margin = static_cast<int>(std::ceil(1.0 / unseen_by->grid.getResolution()));
+		cv::dilate(seen, seen, cv::Mat::ones(2 * margin + 1, 2 * margin + 1, CV_8UC1));
+		const Similarity2D to_seen = unseen_by->cellToMapFrame().inverse().compose(r.truth).compose(map.cellToMapFrame());
+		for (int y = 0; y < int(map.grid.getSizeY()); ++y)
+			for (int x = 0; x < int(map.grid.getSizeX()); ++x)
+			{
+				const Eigen::Vector2d q = to_seen(Eigen::Vector2d(x, y));
+				const int qx = int(std::lround(q.x())), qy = int(std::lround(q.y()));
+				if (qx >= 0 && qy >= 0 && qx < seen.cols && qy < seen.rows && seen.at<uint8_t>(qy, qx))
+					map.grid.setCell(x, y, 0.5f);
+			}
+	}
+	saveGridMap(map, r.file);
+	return r;
+}
+
+const Fleet* fleet()
+{
+	static std::unique_ptr<Fleet> f = []() -> std::unique_ptr<Fleet> {
+		const std::string fr079 = std::string(MMM_SHARED_DATA) + "/carmen_corrected/freiburg-079-corrected.log.gz";
+		const std::string intel = std::string(MMM_SHARED_DATA) + "/carmen_corrected/intel-corrected.log.gz";
+		if (!fileExists(fr079) || !fileExists(intel)) return nullptr;
+		const ScanSequence a = loadScans(fr079), b = loadScans(intel);
+		auto out = std::make_unique<Fleet>();
+		out->robots = {
+			writeRobot(a, 0.00, 0.45, 0.05, {}, 0.3, 0.7, "ref_5cm"),
+			writeRobot(a, 0.30, 0.75, 0.03, {2.0, -1.0, 40 * M_PI / 180}, 0.6, 0.2, "robot_3cm"),
+			writeRobot(a, 0.55, 0.95, 0.08, {-1.5, 3.0, -120 * M_PI / 180}, 0.5, 0.5, "robot_8cm"),
+		};
+		const GridInFrame ref = loadGridMap(out->robots[0].file);
+		out->robots.push_back(writeRobot(a, 0.45, 1.00, 0.04, {4.0, 1.0, 170 * M_PI / 180}, 0.1, 0.9, "robot_4cm", &ref));
+		out->robots.push_back(writeRobot(b, 0.00, 0.60, 0.05, {}, 0.4, 0.4, "other_building"));
+		for (const auto& r : out->robots) out->maps.push_back(loadGridMap(r.file));
+		return out;
+	}();
+	return f.get();
+}
+
+/** RMS displacement of a map's occupied cells between the estimate and the
+ * truth, in cells of the coarser of it and the reference. */
+double errorCoarseCells(const Fleet& f, size_t m, const Similarity2D& estimate)
+{
+	const GridInFrame& map = f.maps[m];
+	std::vector<cv::Point> cells;
+	cv::findNonZero(toClassImage(map.grid) == kOccupied, cells);
+	std::vector<Eigen::Vector2d> pts;
+	for (const auto& c : cells) pts.push_back(map.cellToMapFrame()(Eigen::Vector2d(c.x, c.y)));
+	return pointRmse(estimate, f.robots[m].truth, pts) / std::max(f.robots[0].resolution, f.robots[m].resolution);
+}
+}  // namespace
+
+TEST(Fleet, PlacesEveryRobotOfTheBuildingAndKeepsTheOtherBuildingOut)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const Fleet& f = *fleet();
+	const FleetResult r = placeFleet(f.maps, 0, CScalingGridMapAligner());
+	ASSERT_EQ(r.maps.size(), f.maps.size());
+	EXPECT_TRUE(r.maps[0].placed);
+	for (size_t m = 1; m + 1 < f.maps.size(); ++m)
+	{
+		ASSERT_TRUE(r.maps[m].placed) << f.robots[m].file << ": " << r.maps[m].message;
+		EXPECT_LE(errorCoarseCells(f, m, r.maps[m].in_reference), 2.0) << f.robots[m].file << " " << r.maps[m].message;
+		EXPECT_NEAR(r.maps[m].in_reference.scale, 1.0, 0.01) << f.robots[m].file;
+	}
+	const size_t other_building = f.maps.size() - 1;
+	EXPECT_FALSE(r.maps[other_building].placed);
+	EXPECT_NE(r.maps[other_building].message.find("not placed"), std::string::npos);
+	EXPECT_FALSE(r.allPlaced());
+	// The last robot of the building saw nothing the reference saw: it is
+	// placed through another robot, not directly.
+	EXPECT_GT(r.maps[3].parent, 0) << r.maps[3].message;
+	EXPECT_EQ(r.pairs_aligned + r.pairs_skipped, f.maps.size() * (f.maps.size() - 1) / 2);
+}
+
+TEST(Fleet, FusesThePlacedMapsOnTheReferenceLattice)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const Fleet& f = *fleet();
+	// Placement by the truth: the fusion alone is under test here.
+	FleetResult truth;
+	truth.maps.resize(f.maps.size());
+	for (size_t m = 0; m + 1 < f.maps.size(); ++m) truth.maps[m].placed = true, truth.maps[m].in_reference = f.robots[m].truth;
+	const FusedFleet fused = fuseFleet(f.maps, truth, 0, 0.05);
+	EXPECT_FLOAT_EQ(fused.merged.grid.getResolution(), 0.05f);
+	EXPECT_EQ(fused.merged.origin.t, f.maps[0].origin.t);  // the reference's frame
+	ASSERT_EQ(fused.classes.size(), f.maps.size());
+	EXPECT_TRUE(fused.classes.back().empty());  // not placed, not drawn
+	// Every placed map's walls are walls of the merged map (cell rule: occupied if any).
+	const cv::Mat merged_occ = toClassImage(fused.merged.grid) == kOccupied;
+	for (size_t m = 0; m + 1 < f.maps.size(); ++m)
+	{
+		ASSERT_EQ(fused.classes[m].size(), merged_occ.size());
+		const cv::Mat occ = fused.classes[m] == kOccupied;
+		EXPECT_GT(cv::countNonZero(occ), 100);
+		EXPECT_EQ(cv::countNonZero(occ & ~merged_occ), 0) << "map " << m;
+	}
+	// The merged map covers the union: larger than the reference alone.
+	EXPECT_GT(cv::countNonZero(toClassImage(fused.merged.grid) != kUnknown),
+			  cv::countNonZero(toClassImage(f.maps[0].grid) != kUnknown) * 1.3);
+}
+
+TEST(Fleet, CliReportsEveryMapInArgumentOrder)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const Fleet& f = *fleet();
+	const std::string dir = tmpDir();
+	// Reference, the other building, then two robots of the building.
+	const std::vector<size_t> order = {0, 4, 2, 1};
+	std::string args;
+	for (size_t m : order) args += f.robots[m].file + " ";
+	const CliRun run = runCli(args + "--json " + dir + "/fleet.json --png " + dir + "/fleet.png --out " + dir + "/fleet.yaml");
+	EXPECT_EQ(run.exit_code, 1) << run.output;  // one map not placed
+	const auto j = nlohmann::json::parse(slurp(dir + "/fleet.json"));
+	ASSERT_TRUE(j.contains("maps")) << j.dump();
+	EXPECT_FALSE(j["success"].get<bool>());
+	ASSERT_EQ(j["maps"].size(), order.size() - 1);
+	for (size_t k = 1; k < order.size(); ++k)
+	{
+		const auto& e = j["maps"][k - 1];
+		EXPECT_EQ(e["file"], f.robots[order[k]].file);
+		const bool building = order[k] != 4;
+		ASSERT_EQ(e["success"].get<bool>(), building) << e.dump();
+		if (!building)
+		{
+			EXPECT_FALSE(e["error"].get<std::string>().empty());
+			continue;
+		}
+		const auto& t = e["transform"];
+		const Similarity2D est(t["scale"].get<double>(), t["yaw"].get<double>(),
+							   Eigen::Vector2d(t["x"].get<double>(), t["y"].get<double>()));
+		EXPECT_LE(errorCoarseCells(f, order[k], est), 2.0) << e.dump();
+	}
+	EXPECT_NE(run.output.find("NOT PLACED " + f.robots[4].file), std::string::npos) << run.output;
+	// The maps placed are still merged (on the reference's lattice) and drawn.
+	const Eigen::Vector2d cells =
+		(loadGridMap(dir + "/fleet.yaml").cornerInMapFrame() - f.maps[0].cornerInMapFrame()) / f.robots[0].resolution;
+	EXPECT_NEAR(cells.x(), std::round(cells.x()), 1e-4);
+	EXPECT_NEAR(cells.y(), std::round(cells.y()), 1e-4);
+	EXPECT_FALSE(cv::imread(dir + "/fleet.png").empty());
+}
+
+TEST(Fleet, RefusesTooFewMapsAndABadReference)
+{
+	std::vector<GridInFrame> one(1);
+	EXPECT_THROW(placeFleet(one, 0, CScalingGridMapAligner()), std::invalid_argument);
+	std::vector<GridInFrame> two(2);
+	EXPECT_THROW(placeFleet(two, 2, CScalingGridMapAligner()), std::invalid_argument);
+}
