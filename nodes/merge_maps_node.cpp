@@ -1,5 +1,6 @@
-// merge_maps_node: serves merge_maps (multires_map_merge/MergeMaps) and
-// publishes the last merged map, latched, on merged_map. All the work is in
+// merge_maps_node: serves merge_maps (multires_map_merge/MergeMaps, two maps)
+// and merge_fleet (multires_map_merge/MergeFleet, N maps), and publishes the
+// last merged map, latched, on merged_map. All the work is in
 // MergeMapsService; this file is the ROS plumbing.
 #include <multires_map_merge/ros/AlignerParamsFromRos.h>
 #include <multires_map_merge/ros/MergeMapsService.h>
@@ -49,7 +50,23 @@ int main(int argc, char** argv)
 	};
 	ros::ServiceServer server =
 		nh.advertiseService<MergeMaps::Request, MergeMaps::Response>("merge_maps", serve);
-	ROS_INFO_STREAM("merge_maps: serving " << server.getService() << ", publishing " << merged_pub.getTopic());
+	auto serve_fleet = [&](MergeFleet::Request& req, MergeFleet::Response& res) {
+		service->mergeFleet(req, res);
+		if (!res.merged.data.empty())
+		{
+			res.merged.header.stamp = res.merged.info.map_load_time = ros::Time::now();
+			std::lock_guard<std::mutex> lock(publish_mutex);
+			merged_pub.publish(res.merged);
+		}
+		ROS_INFO_STREAM("merge_fleet: " << res.message << " (" << res.runtime << " s)");
+		for (size_t i = 0; i < res.messages.size(); ++i)
+			if (!res.placed[i]) ROS_WARN_STREAM("merge_fleet: maps[" << i << "] " << res.messages[i]);
+		return true;
+	};
+	ros::ServiceServer fleet_server =
+		nh.advertiseService<MergeFleet::Request, MergeFleet::Response>("merge_fleet", serve_fleet);
+	ROS_INFO_STREAM("merge_maps: serving " << server.getService() << " and " << fleet_server.getService()
+										   << ", publishing " << merged_pub.getTopic());
 
 	ros::AsyncSpinner spinner(threads);
 	spinner.start();

@@ -134,3 +134,100 @@ TEST(MergeMapsService, ParametersAreCheckedAndUsed)
 	ros1::MergeMapsService(trusting).merge(req, res);
 	EXPECT_FALSE(res.success) << "the node-wide parameter must apply too";
 }
+
+namespace
+{
+/** Malaga (Debian's mrpt-common) as three robots' messages: each a share of
+ * the run at its own resolution, in its own frame, with a rotated origin. */
+struct FleetMsgs
+{
+	MergeFleet::Request req;
+	std::vector<Similarity2D> truth;  //!< map i's frame → the reference's
+	std::vector<double> res;
+};
+
+const FleetMsgs& malagaFleet()
+{
+	static const FleetMsgs f = [] {
+		FleetMsgs out;
+		const ScanSequence& s = malagaScans();
+		const size_t n = s.size();
+		struct Robot
+		{
+			double begin, end, res;
+			mrpt::poses::CPose2D frame;
+			Similarity2D origin;
+		};
+		const std::vector<Robot> robots = {
+			{0.0, 0.6, 0.05, {}, rigid(3, -1, 0.3)},
+			{0.4, 1.0, 0.08, {1.5, -2.5, 120 * M_PI / 180}, rigid(-20, 40, -1.0)},
+			{0.2, 0.8, 0.03, {-4, 2, -60 * M_PI / 180}, rigid(7, 7, 2.0)},
+		};
+		for (size_t i = 0; i < robots.size(); ++i)
+		{
+			const Robot& r = robots[i];
+			std_msgs::Header h;
+			h.frame_id = "robot" + std::to_string(i + 1) + "/map";
+			const auto grid = renderGrid(s, size_t(r.begin * n), size_t(r.end * n), r.res, r.frame);
+			out.req.maps.push_back(ros1::msgFromGrid({grid, r.origin}, h));
+			// map frame → grid frame (origin⁻¹) → the run in r.frame → ref grid → ref frame
+			out.truth.push_back(robots[0].origin.compose(Similarity2D(1, r.frame.phi(), {r.frame.x(), r.frame.y()}))
+									.compose(r.origin.inverse()));
+			out.res.push_back(r.res);
+		}
+		return out;
+	}();
+	return f;
+}
+}  // namespace
+
+TEST(MergeFleetService, PlacesEveryMapInTheReferenceFrame)
+{
+	const FleetMsgs& f = malagaFleet();
+	MergeFleet::Response res;
+	ros1::MergeMapsService().mergeFleet(f.req, res);
+	ASSERT_TRUE(res.success) << res.message;
+	ASSERT_EQ(res.placed.size(), 3u);
+	ASSERT_EQ(res.transforms.size(), 3u);
+	for (size_t i = 1; i < 3; ++i)
+	{
+		ASSERT_TRUE(res.placed[i]) << res.messages[i];
+		const Similarity2D got(res.scales[i], res.transforms[i].theta, {res.transforms[i].x, res.transforms[i].y});
+		const GridInFrame map = ros1::gridFromMsg(f.req.maps[i]);
+		PointList pts = edgePoints(toClassImage(map.grid));
+		for (auto& q : pts) q = map.cellToMapFrame()(q);
+		EXPECT_LT(pointRmse(got, f.truth[i], pts) / std::max(f.res[0], f.res[i]), 1.0) << "maps[" << i << "]";
+		EXPECT_NEAR(res.scales[i], 1.0, 0.005);
+		EXPECT_GE(res.confidences[i], 0.5);
+	}
+	EXPECT_EQ(res.merged.header.frame_id, "robot1/map");
+	EXPECT_NEAR(res.merged.info.resolution, 0.05, 1e-6);
+	EXPECT_EQ(res.pairs_aligned + res.pairs_skipped, 3u);
+	EXPECT_GT(res.runtime, 0);
+}
+
+TEST(MergeFleetService, BadRequestsNameTheMapAndTheField)
+{
+	const FleetMsgs& f = malagaFleet();
+	ros1::MergeMapsService service;
+	MergeFleet::Response res;
+	MergeFleet::Request bad = f.req;
+	bad.maps[2].data.resize(10);
+	service.mergeFleet(bad, res);
+	EXPECT_FALSE(res.success);
+	EXPECT_NE(res.message.find("maps[2]"), std::string::npos) << res.message;
+	bad = f.req;
+	bad.reference = 3;
+	service.mergeFleet(bad, res);
+	EXPECT_FALSE(res.success);
+	EXPECT_NE(res.message.find("reference"), std::string::npos) << res.message;
+	bad.maps.resize(1);
+	bad.reference = 0;
+	service.mergeFleet(bad, res);
+	EXPECT_FALSE(res.success);
+	EXPECT_NE(res.message.find("at least two"), std::string::npos) << res.message;
+	bad = f.req;
+	bad.output_resolution = -1;
+	service.mergeFleet(bad, res);
+	EXPECT_NE(res.message.find("output_resolution"), std::string::npos) << res.message;
+}

@@ -80,4 +80,74 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 	res.runtime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Response& res) const
+{
+	const auto start = std::chrono::steady_clock::now();
+	res = MergeFleet::Response();
+	try
+	{
+		const double out_res_req = req.output_resolution;
+		if (!std::isfinite(out_res_req) || out_res_req < 0)
+		{
+			std::ostringstream why;
+			why << "output_resolution must be 0 (the reference's) or metres > 0, not " << out_res_req;
+			throw InvalidGridMessage(why.str());
+		}
+		if (req.maps.size() < 2) throw InvalidGridMessage("maps: give at least two maps");
+		if (req.reference >= req.maps.size())
+			throw InvalidGridMessage(
+				"reference = " + std::to_string(req.reference) + " but there are " + std::to_string(req.maps.size()) + " maps");
+		std::vector<GridInFrame> maps;
+		for (size_t i = 0; i < req.maps.size(); ++i) maps.push_back(gridFromMsg(req.maps[i], "maps[" + std::to_string(i) + "]"));
+
+		CScalingGridMapAligner aligner;
+		aligner.options = params_;
+		aligner.options.use_resolution_metadata = params_.use_resolution_metadata || req.use_resolution_metadata;
+		const FleetResult r = placeFleet(maps, req.reference, aligner);
+		res.pairs_aligned = r.pairs_aligned;
+		res.pairs_skipped = r.pairs_skipped;
+		size_t placed = 0;
+		for (const FleetPlacement& p : r.maps)
+		{
+			res.placed.push_back(p.placed);
+			geometry_msgs::Pose2D t;
+			t.x = p.in_reference.t.x(), t.y = p.in_reference.t.y(), t.theta = p.in_reference.yaw;
+			res.transforms.push_back(t);
+			res.scales.push_back(p.placed ? p.in_reference.scale : 0.0);
+			res.confidences.push_back(p.confidence);
+			res.messages.push_back(p.message);
+			placed += p.placed;
+		}
+		std::ostringstream msg;
+		msg << placed << " of " << maps.size() << " maps placed";
+		res.message = msg.str();
+		if (placed > 1)
+		{
+			const double out_res = out_res_req > 0 ? out_res_req : maps[req.reference].grid.getResolution();
+			try
+			{
+				const FusedFleet fused = fuseFleet(maps, r, req.reference, out_res, max_merged_cells);
+				res.merged = msgFromGrid(fused.merged, req.maps[req.reference].header);
+				res.success = r.allPlaced();
+			}
+			catch (const MergedMapTooLarge& e)
+			{
+				res.message += std::string(", but the ") + e.what() + " at " + std::to_string(out_res) +
+							   " m; ask for a coarser output_resolution";
+			}
+		}
+	}
+	catch (const std::bad_alloc&)
+	{
+		res.success = false;
+		res.message = "not merged: out of memory (maps too large for this machine)";
+	}
+	catch (const std::exception& e)
+	{
+		res.success = false;
+		res.message = std::string("not merged: ") + e.what();
+	}
+	res.runtime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 }  // namespace multires_map_merge::ros1

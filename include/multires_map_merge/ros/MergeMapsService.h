@@ -6,6 +6,8 @@
 
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GridMapFusion.h>
+#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/MergeFleet.h>
 #include <multires_map_merge/MergeMaps.h>
 
 #include <optional>
@@ -41,6 +43,12 @@ class MergeMapsService
 		merge(req, res);
 		return true;
 	}
+
+	/** merge_fleet: N maps into maps[reference]'s frame (FleetMerge.h). Never
+	 * throws; success only when every map was placed, and the merged map then
+	 * holds all of them (else it holds those placed, if any besides the
+	 * reference, and `messages` says why the others were not). */
+	void mergeFleet(const MergeFleet::Request& req, MergeFleet::Response& res) const;
 
 	const CScalingGridMapAligner::TConfigParams& params() const { return params_; }
 
