@@ -9,6 +9,7 @@ pkgs=(
   build-essential cmake pkg-config
   ros-core-dev catkin python3-rostest python3-rosbag python3-nav-msgs python3-geometry-msgs
   libnav-msgs-dev libgeometry-msgs-dev libstd-msgs-dev librosbag-dev ros-message-generation ros-message-runtime
+  libmap-msgs-dev libtf2-ros-dev
   libmrpt-dev libmrpt-ros1bridge-dev mrpt-apps mrpt-common
   libopencv-dev libeigen3-dev libgtest-dev libtclap-dev libyaml-cpp-dev nlohmann-json3-dev
 )

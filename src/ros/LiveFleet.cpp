@@ -1,0 +1,265 @@
+#include <multires_map_merge/GridMapFusion.h>
+#include <multires_map_merge/ros/LiveFleet.h>
+#include <multires_map_merge/ros/OccupancyGridConversion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace multires_map_merge::ros1
+{
+LiveFleet::LiveFleet(const LiveFleetParams& params) : params_(params)
+{
+	if (const std::string why = params_.aligner.invalidReason(); !why.empty())
+		throw std::invalid_argument("invalid aligner parameters: " + why);
+	if (!(params_.output_resolution >= 0) || !std::isfinite(params_.output_resolution))
+		throw std::invalid_argument("output_resolution must be 0 (the world robot's) or metres > 0");
+	if (!(params_.agreement_cells > 0)) throw std::invalid_argument("agreement_cells must be > 0");
+}
+
+LiveFleet::Robot* LiveFleet::find(const std::string& name)
+{
+	for (auto& r : robots_)
+		if (r.name == name) return &r;
+	return nullptr;
+}
+
+const LiveFleet::Robot* LiveFleet::find(const std::string& name) const
+{
+	return const_cast<LiveFleet*>(this)->find(name);
+}
+
+void LiveFleet::addRobot(const std::string& name, const std::optional<Similarity2D>& init_pose)
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	if (find(name)) return;
+	Robot r;
+	r.name = name;
+	r.init_pose = init_pose;
+	r.message = "no map yet";
+	robots_.push_back(std::move(r));
+}
+
+bool LiveFleet::hasRobot(const std::string& name) const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	return find(name) != nullptr;
+}
+
+std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::OccupancyGrid& msg)
+{
+	try
+	{
+		gridFromMsg(msg, robot + "'s map");  // validates: a bad map never replaces a good one
+	}
+	catch (const std::exception& e)
+	{
+		return std::string("ignored: ") + e.what();
+	}
+	std::lock_guard<std::mutex> lock(mutex_);
+	Robot* r = find(robot);
+	if (!r) return "ignored: unknown robot '" + robot + "'";
+	if (r->map && r->map->header.stamp > msg.header.stamp)
+		return "ignored: older than the map held for " + robot;
+	r->map = msg;
+	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
+	return "";
+}
+
+std::string LiveFleet::onUpdate(const std::string& robot, const map_msgs::OccupancyGridUpdate& msg)
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	Robot* r = find(robot);
+	if (!r) return "ignored update: unknown robot '" + robot + "'";
+	if (!r->map) return "ignored update for " + robot + ": no full map to update yet";
+	std::ostringstream why;
+	if (uint64_t(msg.width) * msg.height != msg.data.size())
+		why << "data has " << msg.data.size() << " cells, not width x height = " << msg.width << " x " << msg.height;
+	else if (msg.x < 0 || msg.y < 0)
+		why << "negative x, y (" << msg.x << ", " << msg.y << ")";
+	else if (std::any_of(msg.data.begin(), msg.data.end(), [](int8_t v) { return v < -1 || v > 100; }))
+		why << "a cell value outside -1..100";
+	nav_msgs::OccupancyGrid& map = *r->map;
+	if (why.tellp() == 0 && (uint64_t(msg.x) >= map.info.width || uint64_t(msg.y) >= map.info.height))
+		why << "region at (" << msg.x << ", " << msg.y << ") lies outside the " << map.info.width << " x "
+			<< map.info.height << " map";
+	if (why.tellp() > 0) return "ignored update for " + robot + ": " + why.str();
+	// What fits is applied (as map_server's consumers do); the rest is cut.
+	const uint32_t w = std::min<uint32_t>(msg.width, map.info.width - msg.x);
+	const uint32_t h = std::min<uint32_t>(msg.height, map.info.height - msg.y);
+	for (uint32_t y = 0; y < h; ++y)
+		std::copy_n(msg.data.begin() + size_t(y) * msg.width, w,
+					map.data.begin() + size_t(msg.y + y) * map.info.width + msg.x);
+	if (msg.header.stamp > map.header.stamp) map.header.stamp = msg.header.stamp;
+	return "";
+}
+
+bool LiveFleet::agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const
+{
+	const Similarity2D cells = map.cellToMapFrame();
+	const double w = map.grid.getSizeX() - 1, h = map.grid.getSizeY() - 1;
+	double se = 0;
+	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
+		se += (a(cells(c)) - b(cells(c))).squaredNorm();
+	const double cell = map.grid.getResolution() * std::max(a.scale, b.scale);
+	return std::sqrt(se / 4) <= params_.agreement_cells * cell;
+}
+
+void LiveFleet::estimate()
+{
+	// Snapshot under the lock; align without it (maps keep arriving).
+	std::vector<std::string> names;
+	std::vector<GridInFrame> maps;
+	size_t world = 0;
+	{
+		std::lock_guard<std::mutex> lock(mutex_);
+		++estimations_;
+		if (params_.known_init_poses)
+		{
+			for (auto& r : robots_)
+			{
+				r.placed = r.map && r.init_pose;
+				if (r.placed) r.in_world = *r.init_pose, r.confidence = 1, r.message = "placed at its known initial pose";
+				else if (r.map) r.message = "no initial pose (map_merge/init_pose_x, _y, _z, _yaw in its namespace)";
+			}
+			return;
+		}
+		if (world_robot_.empty()) return;
+		for (const auto& r : robots_)
+			if (r.map)
+			{
+				if (r.name == world_robot_) world = names.size();
+				names.push_back(r.name);
+				maps.push_back(gridFromMsg(*r.map, r.name));  // validated on arrival
+			}
+	}
+	std::optional<FleetResult> result;
+	std::string failure;
+	if (maps.size() >= 2)
+	{
+		try
+		{
+			CScalingGridMapAligner aligner;
+			aligner.options = params_.aligner;
+			result = placeFleet(maps, world, aligner);
+		}
+		catch (const std::exception& e)
+		{
+			failure = e.what();
+		}
+	}
+	std::lock_guard<std::mutex> lock(mutex_);
+	for (size_t i = 0; i < names.size(); ++i)
+	{
+		Robot& r = *find(names[i]);
+		if (i == world)
+		{
+			r.placed = true, r.in_world = Similarity2D(), r.confidence = 1, r.message = "the world frame is its map frame";
+			continue;
+		}
+		if (!result)
+		{
+			if (!failure.empty()) r.message = (r.placed ? "kept its placement; estimation failed: " : "estimation failed: ") + failure;
+			continue;
+		}
+		const FleetPlacement& p = result->maps[i];
+		if (!p.placed)
+		{
+			r.message = r.placed ? "kept its last placement; latest estimate: " + p.message : p.message;
+			continue;
+		}
+		const std::string through = p.parent >= 0 && size_t(p.parent) != world ? " through " + names[p.parent] : "";
+		if (!r.placed || agree(maps[i], r.in_world, p.in_reference))
+		{
+			r.message = (r.placed ? "placement refined" : "placed") + through;
+			r.placed = true, r.in_world = p.in_reference, r.confidence = p.confidence, r.pending.reset();
+		}
+		else if (r.pending && agree(maps[i], *r.pending, p.in_reference))
+		{
+			r.message = "moved to a new placement confirmed twice" + through;
+			r.in_world = p.in_reference, r.confidence = p.confidence, r.pending.reset();
+		}
+		else
+		{
+			r.pending = p.in_reference;
+			r.message = "kept its placement; a different one awaits confirmation" + through;
+		}
+	}
+}
+
+std::optional<nav_msgs::OccupancyGrid> LiveFleet::merged(const std::string& world_frame, std::string* why)
+{
+	std::vector<GridInFrame> maps;
+	FleetResult placement;
+	std_msgs::Header header;
+	size_t ref = 0;  // the world robot, else (known poses) the first placed: a rigid placement
+	{
+		std::lock_guard<std::mutex> lock(mutex_);
+		for (const auto& r : robots_)
+			if (r.map && r.placed)
+			{
+				if (r.name == world_robot_) ref = maps.size();
+				maps.push_back(gridFromMsg(*r.map, r.name));
+				FleetPlacement p;
+				p.placed = true, p.in_reference = r.in_world, p.confidence = r.confidence;
+				placement.maps.push_back(p);
+				if (r.map->header.stamp > header.stamp) header.stamp = r.map->header.stamp;
+			}
+	}
+	if (maps.empty())
+	{
+		if (why) *why = "no robot placed yet";
+		return std::nullopt;
+	}
+	try
+	{
+		// Fused in the reference robot's map frame, then put in the world: the
+		// world is that frame, or (known poses) where the poses are given.
+		const Similarity2D to_world = placement.maps[ref].in_reference;
+		for (auto& p : placement.maps) p.in_reference = to_world.inverse().compose(p.in_reference);
+		const double res = params_.output_resolution > 0 ? params_.output_resolution : maps[ref].grid.getResolution();
+		FusedFleet fused = fuseFleet(maps, placement, ref, res, params_.max_merged_cells);
+		fused.merged.origin = to_world.compose(fused.merged.origin);
+		header.frame_id = world_frame;
+		return msgFromGrid(fused.merged, header);
+	}
+	catch (const std::exception& e)
+	{
+		if (why) *why = e.what();
+		return std::nullopt;
+	}
+}
+
+std::vector<LiveFleet::RobotStatus> LiveFleet::status() const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	std::vector<RobotStatus> out;
+	for (const auto& r : robots_)
+	{
+		RobotStatus s;
+		s.name = r.name;
+		s.frame_id = r.map && !r.map->header.frame_id.empty() ? r.map->header.frame_id : r.name + "/map";
+		s.has_map = r.map.has_value();
+		s.placed = r.placed;
+		s.in_world = r.in_world;
+		s.confidence = r.confidence;
+		s.message = r.message;
+		out.push_back(s);
+	}
+	return out;
+}
+
+std::string LiveFleet::worldRobot() const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	return world_robot_;
+}
+
+size_t LiveFleet::estimations() const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	return estimations_;
+}
+
+}  // namespace multires_map_merge::ros1
