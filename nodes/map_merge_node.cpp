@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 using namespace multires_map_merge;
@@ -194,10 +195,13 @@ int main(int argc, char** argv)
 				if (last_messages[r.name] != r.message)
 				{
 					last_messages[r.name] = r.message;
-					ROS_INFO_STREAM("map_merge: " << r.name << ": " << r.message
-												  << (r.placed && std::abs(r.in_world.scale - 1) > 1e-3
-														  ? " (scale " + std::to_string(r.in_world.scale) + ": its stated resolution is off)"
-														  : std::string()));
+					std::ostringstream pose;
+					if (r.placed)
+						pose << " [" << s.world_frame << " -> " << r.frame_id << ": x " << r.in_world.t.x() << " m, y "
+							 << r.in_world.t.y() << " m, yaw " << r.in_world.yaw * 180 / M_PI << " deg, scale "
+							 << r.in_world.scale << "]"
+							 << (std::abs(r.in_world.scale - 1) > 1e-3 ? " (its stated resolution is off; TF carries the rigid part)" : "");
+					ROS_INFO_STREAM("map_merge: " << r.name << ": " << r.message << pose.str());
 				}
 		});
 	discover();

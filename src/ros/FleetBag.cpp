@@ -2,6 +2,7 @@
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <map_msgs/OccupancyGridUpdate.h>
+#include <boost/make_shared.hpp>
 #include <rosbag/bag.h>
 
 #include <algorithm>
@@ -44,6 +45,16 @@ void writeFleetBag(const std::string& bag_path, const std::vector<FleetBagRobot>
 	{
 		throw std::runtime_error("'" + bag_path + "': cannot write the bag (" + e.what() + ")");
 	}
+	// Maps latched, as SLAM nodes publish them: `rosbag play --keep-alive`
+	// then serves the last one to a late subscriber (the merger discovers
+	// robots every few seconds).
+	// A connection header replaces rosbag's own: it must name the type too.
+	auto latched = boost::make_shared<ros::M_string>();
+	(*latched)["type"] = ros::message_traits::datatype<nav_msgs::OccupancyGrid>();
+	(*latched)["md5sum"] = ros::message_traits::md5sum<nav_msgs::OccupancyGrid>();
+	(*latched)["message_definition"] = ros::message_traits::definition<nav_msgs::OccupancyGrid>();
+	(*latched)["callerid"] = "/fleet_bag";
+	(*latched)["latching"] = "1";
 	std::map<std::string, ScanSequence> logs;
 	const ros::Time t0(1000, 0);
 	for (const auto& r : robots)
@@ -67,7 +78,7 @@ void writeFleetBag(const std::string& bag_path, const std::vector<FleetBagRobot>
 			now.header = h;
 			now.info.map_load_time = h.stamp;
 			if (k == r.join_step || k % 2 == 0)
-				bag.write(r.name + "/map", h.stamp, now);
+				bag.write(r.name + "/map", h.stamp, now, latched);
 			else
 			{
 				// The bounding box of what changed.
