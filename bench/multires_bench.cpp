@@ -8,6 +8,7 @@
 
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/EdgePoints.h>
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
@@ -452,6 +453,156 @@ ScalingCase runScalingCase(const std::string& self, int cells)
 	return c;
 }
 
+// ---------------------------------------------------------------- fleets (child process)
+struct FleetCase
+{
+	std::string name;
+	int maps = 0;
+	std::string sizes;  //!< "w×h @ res" of each map
+	double seconds = 0, peak_mb = 0;
+	size_t aligned = 0, skipped = 0, building = 0, placed_right = 0, placed_wrong = 0, others_placed = 0;
+	double max_err = NAN;  //!< worst placement error, cells of the coarser map of its pair with the reference
+};
+
+/** In the child: places and fuses the fleet map_0.yaml, map_1.yaml, ... of
+ * `dir` (map_0 the reference); prints the time, the pairs and each placement. */
+int fleetChild(const std::string& dir)
+{
+	std::vector<GridInFrame> maps;
+	for (int i = 0; fs::exists(dir + "/map_" + std::to_string(i) + ".yaml"); ++i)
+		maps.push_back(loadGridMap(dir + "/map_" + std::to_string(i) + ".yaml"));
+	mrpt::system::CTicTac clock;
+	const FleetResult r = placeFleet(maps, 0, CScalingGridMapAligner());
+	const FusedFleet fused = fuseFleet(maps, r, 0, maps[0].grid.getResolution());
+	const double seconds = clock.Tac();
+	std::ifstream status("/proc/self/status");
+	double hwm_kb = 0;
+	for (std::string line; std::getline(status, line);)
+		if (line.rfind("VmHWM:", 0) == 0) hwm_kb = std::stod(line.substr(6));
+	std::cout << std::setprecision(12) << "FLEET " << seconds << " " << r.pairs_aligned << " " << r.pairs_skipped << " "
+			  << hwm_kb / 1024 << " " << fused.merged.grid.getSizeX() << std::endl;
+	for (size_t i = 0; i < r.maps.size(); ++i)
+	{
+		const auto& p = r.maps[i].in_reference;
+		std::cout << "MAP " << i << " " << r.maps[i].placed << " " << p.scale << " " << p.yaw << " " << p.t.x() << " "
+				  << p.t.y() << std::endl;
+	}
+	return 0;
+}
+
+/** A fleet of `n` robots of fr079, each a 40 % share of the run spread over
+ * it, at resolutions cycling over 5, 3, 8, 4, 6, 10, 2.5, 7 cm, in frames
+ * turned by 37° more each, origins off the lattice, as map_server files;
+ * `pad_to` > 0 pads each to that many cells a side; `other_building` adds
+ * an intel robot that must stay out. Placed in a fresh process. */
+FleetCase runFleetCase(const std::string& self, const std::string& name, int n, int pad_to, bool other_building,
+					   double fixed_res = 0)
+{
+	FleetCase c;
+	c.name = name;
+	c.maps = n + other_building;
+	const fs::path dir = fs::temp_directory_path() / ("multires_bench_fleet_" + std::to_string(getpid()));
+	fs::remove_all(dir);
+	fs::create_directories(dir);
+	const std::vector<double> res_cycle = {0.05, 0.03, 0.08, 0.04, 0.06, 0.10, 0.025, 0.07};
+	std::vector<Similarity2D> truth;
+	std::vector<double> res;
+	std::vector<GridInFrame> written;
+	for (int i = 0; i < c.maps; ++i)
+	{
+		const bool other = i == n;
+		const ScanSequence& s = scansOf(other ? "intel" : "fr079");
+		const double r = fixed_res > 0 ? fixed_res : res_cycle[i % res_cycle.size()];
+		const double begin = other || n == 1 ? 0.0 : 0.6 * i / (n - 1);
+		const mrpt::poses::CPose2D frame = i == 0 || other ? mrpt::poses::CPose2D()
+														   : mrpt::poses::CPose2D(0.5 * i, -0.3 * i, (37.0 * i) * M_PI / 180);
+		GridInFrame g = renderGridOffLattice(
+			s, size_t(begin * s.size()), size_t(std::min(1.0, begin + 0.4) * s.size()), r, frame, 0.37 * r, 0.61 * r);
+		if (pad_to > 0)
+		{
+			const float cell = g.grid.getResolution();
+			const int w = std::max<int>(pad_to, g.grid.getSizeX()), h = std::max<int>(pad_to, g.grid.getSizeY());
+			g.grid.resizeGrid(g.grid.getXMin(), g.grid.getXMin() + w * cell, g.grid.getYMin(), g.grid.getYMin() + h * cell, 0.5f, false);
+		}
+		saveGridMap(g, (dir / ("map_" + std::to_string(i) + ".yaml")).string());
+		truth.push_back(Similarity2D(1, frame.phi(), {frame.x(), frame.y()}));
+		res.push_back(r);
+		c.sizes += (i ? ", " : "") + std::to_string(g.grid.getSizeX()) + "×" + std::to_string(g.grid.getSizeY()) + " @ " +
+			num(r * 100, 1) + " cm";
+		written.push_back(loadGridMap((dir / ("map_" + std::to_string(i) + ".yaml")).string()));
+	}
+	const std::string out = (dir / "out.txt").string();
+	const pid_t pid = spawnSelf({self, "--fleet-child", dir.string()}, out);
+	if (pid < 0) throw std::runtime_error("cannot start " + self);
+	int status = 0;
+	waitpid(pid, &status, 0);
+	std::ifstream f(out);
+	double worst = 0;
+	c.building = n - 1;
+	for (std::string line; std::getline(f, line);)
+	{
+		std::istringstream in(line.substr(line.find(' ') + 1));
+		if (line.rfind("FLEET ", 0) == 0)
+		{
+			unsigned merged_w = 0;
+			in >> c.seconds >> c.aligned >> c.skipped >> c.peak_mb >> merged_w;
+		}
+		else if (line.rfind("MAP ", 0) == 0)
+		{
+			int i = 0;
+			bool placed = false;
+			double sc = 1, yaw = 0, x = 0, y = 0;
+			in >> i >> placed >> sc >> yaw >> x >> y;
+			if (i == 0 || !placed) continue;
+			if (i >= n)
+			{
+				++c.others_placed;
+				continue;
+			}
+			const double e = pointRmse(Similarity2D(sc, yaw, {x, y}), truth[i], metricEdges(written[i])) / std::max(res[0], res[i]);
+			worst = std::max(worst, e);
+			(e <= 2 ? c.placed_right : c.placed_wrong)++;
+		}
+	}
+	if (!(c.seconds > 0)) throw std::runtime_error("fleet case " + name + " failed (see " + out + ")");
+	c.max_err = c.placed_right + c.placed_wrong ? worst : NAN;
+	fs::remove_all(dir);
+	std::cout << "fleet " << name << ": " << c.placed_right << "/" << c.building << " placed right, " << c.placed_wrong
+			  << " wrong, " << c.others_placed << " of another building placed; " << c.aligned << " pairs aligned, "
+			  << c.skipped << " skipped; " << c.seconds << " s, peak " << c.peak_mb << " MB" << std::endl;
+	return c;
+}
+
+std::vector<FleetCase> runFleets(const std::string& self, bool quick)
+{
+	std::vector<FleetCase> cases;
+	for (int n : quick ? std::vector<int>{3} : std::vector<int>{2, 3, 4, 5, 6, 7, 8})
+		cases.push_back(runFleetCase(self, "N = " + std::to_string(n), n, 0, false));
+	if (!quick)
+	{
+		cases.push_back(runFleetCase(self, "5 / 3 / 8 cm + another building (4 cm)", 3, 0, true));
+		cases.push_back(runFleetCase(self, "8 maps of 1000×1000 cells", 8, 1000, false, 0.05));
+	}
+	return cases;
+}
+
+void writeFleetSection(std::ostream& md, const std::vector<FleetCase>& cases)
+{
+	md << "\n## Fleets: N maps into one\n\n"
+	   << "Robots of fr079, each mapping a 40 % share of the run (the shares spread over it, so robot i overlaps "
+		  "its neighbours, not necessarily the reference), at its own resolution and in its own frame (turned by "
+		  "37° more each, origins off the lattice), written as map_server files; `placeFleet` + `fuseFleet` in a "
+		  "fresh process (time and peak RSS of the whole placement and fusion). **Right** = placed within 2 cells "
+		  "of the coarser map of the robot and the reference, against the exact truth.\n\n"
+	   << "| fleet | maps (cells @ resolution) | placed right | placed wrong | other building placed | pairs aligned | "
+		  "pairs skipped | worst error [cells] | time [s] | peak RSS [MB] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+	for (const auto& c : cases)
+		md << "| " << c.name << " | " << c.sizes << " | " << c.placed_right << " / " << c.building << " | "
+		   << c.placed_wrong << " | " << (c.maps > int(c.building) + 1 ? std::to_string(c.others_placed) : "–") << " | "
+		   << c.aligned << " | " << c.skipped << " | " << num(c.max_err, 2) << " | " << num(c.seconds, 1) << " | "
+		   << num(c.peak_mb, 0) << " |\n";
+}
+
 // ---------------------------------------------------------------- basin of convergence
 struct BasinCell
 {
@@ -767,6 +918,8 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<std::string> sets_arg(
 		"", "sets", "only these accuracy sets (resolution, other-logs, rotation), printing their medians", false, "",
 		"SETS", cmd);
+	TCLAP::SwitchArg fleet_arg("", "fleet-only", "only the fleet section (printed as markdown)", cmd);
+	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
 	TCLAP::ValueArg<std::string> mrpt_child("", "mrpt-align", "internal: MRPT's aligner in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_ref("", "scaling-align", "internal: align in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_other("", "scaling-other", "internal: with --scaling-align", false, "", "OTHER", cmd);
@@ -781,6 +934,7 @@ int main(int argc, char** argv)
 	}
 	if (child_ref.isSet()) return scalingChild(child_ref.getValue(), child_other.getValue());
 	if (mrpt_child.isSet()) return mrptChild(mrpt_child.getValue(), child_other.getValue());
+	if (fleet_child.isSet()) return fleetChild(fleet_child.getValue());
 	g_data = data_arg.getValue();
 	if (g_data.empty()) g_data = (fs::path(argv[0]).parent_path() / "../../../../shared/data").lexically_normal();
 	if (!fs::is_directory(g_data + "/carmen_corrected"))
@@ -827,6 +981,11 @@ int main(int argc, char** argv)
 		}
 		if (sets_arg.isSet())
 			return runAccuracySets(sets_arg.getValue());
+		if (fleet_arg.isSet())
+		{
+			writeFleetSection(std::cout, runFleets(fs::canonical("/proc/self/exe"), quick));
+			return 0;
+		}
 		const auto started = std::chrono::steady_clock::now();
 		std::vector<PairResult> all;
 
@@ -877,6 +1036,9 @@ int main(int argc, char** argv)
 		std::vector<ScalingCase> scaling;
 		for (const int cells : quick ? std::vector<int>{500} : std::vector<int>{500, 1000, 2000, 4000})
 			scaling.push_back(runScalingCase(fs::canonical("/proc/self/exe"), cells));
+
+		// 4b. Fleets: N maps into one (fresh process each).
+		const std::vector<FleetCase> fleets = runFleets(fs::canonical("/proc/self/exe"), quick);
 
 		// 5. Basin of convergence of TsICP alone.
 		const std::vector<double> dyaws = quick ? std::vector<double>{-8, 0, 8}
@@ -1151,6 +1313,8 @@ int main(int argc, char** argv)
 		auto basinShare = [](const std::vector<BasinCell>& b) {
 			return std::count_if(b.begin(), b.end(), [](auto& c) { return c.converged; });
 		};
+		writeFleetSection(md, fleets);
+
 		md << "\n## Basin of convergence of TsICP alone (Fig. 7 analogue)\n\n"
 		   << "TsICP started from the truth rotated by Δθ and scaled by Δs about the other map's centre; converged = "
 			  "edge-point RMSE ≤ 0.5 coarse cell afterwards. 5 vs 5 cm: "
@@ -1180,6 +1344,25 @@ int main(int argc, char** argv)
 		target("median scale error ≤ 0.05 %", num(m_scale, 4) + " %", m_scale <= 0.05);
 		target("median runtime no slower than MRPT on same-resolution pairs (ratio ≤ 1)", num(median(ratios), 2),
 			   median(ratios) <= 1);
+		for (const std::string set : {"rotation", "other-logs"})
+		{
+			std::vector<double> e;
+			for (const auto& r : all)
+				if (r.set == set && r.correct) e.push_back(r.rmse);
+			if (!e.empty())
+				target("median point RMSE ≤ 0.15 coarse cell, " + set + " (map_server files)", num(median(e), 3),
+					   median(e) <= 0.15);
+		}
+		for (const auto& c : fleets)
+		{
+			if (c.name.find("another building") != std::string::npos)
+				target("fleet " + c.name + ": every robot of the building placed within 2 cells, the other kept out",
+					   std::to_string(c.placed_right) + " / " + std::to_string(c.building) + ", other placed: " +
+						   std::to_string(c.others_placed),
+					   c.placed_right == c.building && c.others_placed == 0);
+			if (c.name.find("1000×1000") != std::string::npos)
+				target("fleet of 8 maps of 1000×1000 cells in ≤ 3 s on 2 cores", num(c.seconds, 1) + " s", c.seconds <= 3);
+		}
 		target("zero false merges", std::to_string(false_merges) + " / " + std::to_string(negatives.size()), false_merges == 0);
 		if (!quick)
 		{
