@@ -7,6 +7,7 @@
 #include <multires_map_merge/FleetStatus.h>
 #include <multires_map_merge/ros/AlignerParamsFromRos.h>
 #include <multires_map_merge/ros/LiveFleet.h>
+#include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/callback_queue.h>
@@ -157,9 +158,7 @@ int main(int argc, char** argv)
 			st.robots.push_back(r.name);
 			st.frames.push_back(r.frame_id);
 			st.placed.push_back(r.placed);
-			geometry_msgs::Pose2D p;
-			p.x = r.in_world.t.x(), p.y = r.in_world.t.y(), p.theta = r.in_world.yaw;
-			st.transforms.push_back(p);
+			st.transforms.push_back(ros1::pose2DOf(r.in_world));
 			st.scales.push_back(r.placed ? r.in_world.scale : 0.0);
 			st.confidences.push_back(r.confidence);
 			st.messages.push_back(r.message);

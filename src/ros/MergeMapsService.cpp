@@ -8,6 +8,30 @@
 
 namespace multires_map_merge::ros1
 {
+namespace
+{
+/** Runs `body`: whatever it throws becomes an answer (success = false, the
+ * reason in the message), never a dead service. */
+template <class Response, class Body>
+void answerEvenIfItThrows(Response& res, Body body)
+{
+	try
+	{
+		body();
+	}
+	catch (const std::bad_alloc&)
+	{
+		res.success = false;
+		res.message = "not merged: out of memory (maps too large for this machine)";
+	}
+	catch (const std::exception& e)
+	{
+		res.success = false;
+		res.message = std::string("not merged: ") + e.what();
+	}
+}
+}  // namespace
+
 MergeMapsService::MergeMapsService(const CScalingGridMapAligner::TConfigParams& params) : params_(params)
 {
 	if (const std::string why = params_.invalidReason(); !why.empty())
@@ -19,8 +43,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 	const auto start = std::chrono::steady_clock::now();
 	res = MergeMaps::Response();
 	res.success = false;
-	try
-	{
+	answerEvenIfItThrows(res, [&]() {
 		const double out_res_req = req.output_resolution;
 		if (!std::isfinite(out_res_req) || out_res_req < 0)
 		{
@@ -43,9 +66,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 		else
 		{
 			const Similarity2D& world = info.metric;  // between the messages' frames
-			res.transform.x = world.t.x();
-			res.transform.y = world.t.y();
-			res.transform.theta = world.yaw;
+			res.transform = pose2DOf(world);
 			res.scale = world.scale;
 			res.scale_cells = info.cells.scale;
 			res.implied_resolution_other = info.implied_resolution_other;
@@ -65,17 +86,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 							  " m; ask for a coarser output_resolution";
 			}
 		}
-	}
-	catch (const std::bad_alloc&)
-	{
-		res.success = false;
-		res.message = "not merged: out of memory (maps too large for this machine)";
-	}
-	catch (const std::exception& e)
-	{
-		res.success = false;
-		res.message = std::string("not merged: ") + e.what();
-	}
+	});
 	if (!res.success) res.merged = nav_msgs::OccupancyGrid();
 	res.runtime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -84,8 +95,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 {
 	const auto start = std::chrono::steady_clock::now();
 	res = MergeFleet::Response();
-	try
-	{
+	answerEvenIfItThrows(res, [&]() {
 		const double out_res_req = req.output_resolution;
 		if (!std::isfinite(out_res_req) || out_res_req < 0)
 		{
@@ -110,9 +120,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 		for (const FleetPlacement& p : r.maps)
 		{
 			res.placed.push_back(p.placed);
-			geometry_msgs::Pose2D t;
-			t.x = p.in_reference.t.x(), t.y = p.in_reference.t.y(), t.theta = p.in_reference.yaw;
-			res.transforms.push_back(t);
+			res.transforms.push_back(pose2DOf(p.in_reference));
 			res.scales.push_back(p.placed ? p.in_reference.scale : 0.0);
 			res.confidences.push_back(p.confidence);
 			res.messages.push_back(p.message);
@@ -136,17 +144,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 							   " m; ask for a coarser output_resolution";
 			}
 		}
-	}
-	catch (const std::bad_alloc&)
-	{
-		res.success = false;
-		res.message = "not merged: out of memory (maps too large for this machine)";
-	}
-	catch (const std::exception& e)
-	{
-		res.success = false;
-		res.message = std::string("not merged: ") + e.what();
-	}
+	});
 	res.runtime = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

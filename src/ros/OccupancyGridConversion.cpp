@@ -117,4 +117,11 @@ nav_msgs::OccupancyGrid msgFromGrid(const GridInFrame& map, const std_msgs::Head
 	return msg;
 }
 
+geometry_msgs::Pose2D pose2DOf(const Similarity2D& t)
+{
+	geometry_msgs::Pose2D p;
+	p.x = t.t.x(), p.y = t.t.y(), p.theta = t.yaw;
+	return p;
+}
+
 }  // namespace multires_map_merge::ros1

@@ -12,6 +12,7 @@
 #include <multires_map_merge/GridInFrame.h>
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
+#include <geometry_msgs/Pose2D.h>
 #include <nav_msgs/OccupancyGrid.h>
 
 #include <stdexcept>
@@ -41,5 +42,9 @@ nav_msgs::OccupancyGrid msgFromGrid(const GridInFrame& map, const std_msgs::Head
 /** The pose of info.origin as a rigid Similarity2D; throws InvalidGridMessage
  * when it is not finite or not a rotation about z. */
 Similarity2D originOf(const nav_msgs::OccupancyGrid& msg, const std::string& what = "map");
+
+/** The rigid part of a similarity as a Pose2D (x, y, theta = yaw); the
+ * scale travels beside it. */
+geometry_msgs::Pose2D pose2DOf(const Similarity2D& t);
 
 }  // namespace multires_map_merge::ros1
