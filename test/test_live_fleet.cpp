@@ -166,12 +166,16 @@ TEST(LiveFleet, GarbageMessagesAreIgnoredWithAReason)
 	EXPECT_NE(fleet.onUpdate(R[0].name, u).find("negative"), std::string::npos);
 	u = up, u.x = int(good.info.width);
 	EXPECT_NE(fleet.onUpdate(R[0].name, u).find("outside"), std::string::npos);
+	fleet.estimate();
+	const auto before = fleet.merged("world");
+	ASSERT_TRUE(before);
+	const GridInFrame g = ros1::gridFromMsg(good);
+	EXPECT_GT(ros1::gridFromMsg(*before).grid.getCell(g.grid.getSizeX() - 1, 0), 0.1f);  // not occupied yet
 	u = up, u.x = int(good.info.width) - 1, u.y = 0;
 	EXPECT_EQ(fleet.onUpdate(R[0].name, u), "");
-	fleet.estimate();
-	const auto merged = fleet.merged("world");
+	const auto merged = fleet.merged("world");  // no estimation between: the update alone must show
 	ASSERT_TRUE(merged);  // the good map, with the update, survives
-	const GridInFrame m = ros1::gridFromMsg(*merged), g = ros1::gridFromMsg(good);
+	const GridInFrame m = ros1::gridFromMsg(*merged);
 	EXPECT_EQ(m.grid.getSizeX(), g.grid.getSizeX());
 	EXPECT_LT(m.grid.getCell(g.grid.getSizeX() - 1, 0), 0.1f);  // the updated corner cell: occupied (MRPT: 0)
 }

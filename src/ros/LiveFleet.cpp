@@ -63,6 +63,7 @@ std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::Occupancy
 	if (r->map && r->map->header.stamp > msg.header.stamp)
 		return "ignored: older than the map held for " + robot;
 	r->map = msg;
+	++version_;
 	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
 	return "";
 }
@@ -92,6 +93,7 @@ std::string LiveFleet::onUpdate(const std::string& robot, const map_msgs::Occupa
 		std::copy_n(msg.data.begin() + size_t(y) * msg.width, w,
 					map.data.begin() + size_t(msg.y + y) * map.info.width + msg.x);
 	if (msg.header.stamp > map.header.stamp) map.header.stamp = msg.header.stamp;
+	++version_;
 	return "";
 }
 
@@ -117,6 +119,7 @@ void LiveFleet::estimate()
 		++estimations_;
 		if (params_.known_init_poses)
 		{
+			++version_;
 			for (auto& r : robots_)
 			{
 				r.placed = r.map && r.init_pose;
@@ -150,6 +153,7 @@ void LiveFleet::estimate()
 		}
 	}
 	std::lock_guard<std::mutex> lock(mutex_);
+	++version_;  // placements may have changed
 	for (size_t i = 0; i < names.size(); ++i)
 	{
 		Robot& r = *find(names[i]);
@@ -194,8 +198,15 @@ std::optional<nav_msgs::OccupancyGrid> LiveFleet::merged(const std::string& worl
 	FleetResult placement;
 	std_msgs::Header header;
 	size_t ref = 0;  // the world robot, else (known poses) the first placed: a rigid placement
+	size_t version = 0;
 	{
 		std::lock_guard<std::mutex> lock(mutex_);
+		if (merged_version_ == version_ && merged_frame_ == world_frame)
+		{
+			if (why) *why = merged_why_;
+			return merged_cache_;
+		}
+		version = version_;
 		for (const auto& r : robots_)
 			if (r.map && r.placed)
 			{
@@ -207,28 +218,34 @@ std::optional<nav_msgs::OccupancyGrid> LiveFleet::merged(const std::string& worl
 				if (r.map->header.stamp > header.stamp) header.stamp = r.map->header.stamp;
 			}
 	}
+	std::optional<nav_msgs::OccupancyGrid> result;
+	std::string failure;
 	if (maps.empty())
+		failure = "no robot placed yet";
+	else
 	{
-		if (why) *why = "no robot placed yet";
-		return std::nullopt;
+		try
+		{
+			// Fused in the reference robot's map frame, then put in the world:
+			// the world is that frame, or (known poses) where they are given.
+			const Similarity2D to_world = placement.maps[ref].in_reference;
+			for (auto& p : placement.maps) p.in_reference = to_world.inverse().compose(p.in_reference);
+			const double res = params_.output_resolution > 0 ? params_.output_resolution : maps[ref].grid.getResolution();
+			FusedFleet fused = fuseFleet(maps, placement, ref, res, params_.max_merged_cells);
+			fused.merged.origin = to_world.compose(fused.merged.origin);
+			header.frame_id = world_frame;
+			result = msgFromGrid(fused.merged, header);
+		}
+		catch (const std::exception& e)
+		{
+			failure = e.what();
+		}
 	}
-	try
-	{
-		// Fused in the reference robot's map frame, then put in the world: the
-		// world is that frame, or (known poses) where the poses are given.
-		const Similarity2D to_world = placement.maps[ref].in_reference;
-		for (auto& p : placement.maps) p.in_reference = to_world.inverse().compose(p.in_reference);
-		const double res = params_.output_resolution > 0 ? params_.output_resolution : maps[ref].grid.getResolution();
-		FusedFleet fused = fuseFleet(maps, placement, ref, res, params_.max_merged_cells);
-		fused.merged.origin = to_world.compose(fused.merged.origin);
-		header.frame_id = world_frame;
-		return msgFromGrid(fused.merged, header);
-	}
-	catch (const std::exception& e)
-	{
-		if (why) *why = e.what();
-		return std::nullopt;
-	}
+	if (why) *why = failure;
+	std::lock_guard<std::mutex> lock(mutex_);
+	if (version_ == version)  // nothing changed meanwhile: keep it for the next call
+		merged_version_ = version, merged_cache_ = result, merged_why_ = failure, merged_frame_ = world_frame;
+	return result;
 }
 
 std::vector<LiveFleet::RobotStatus> LiveFleet::status() const

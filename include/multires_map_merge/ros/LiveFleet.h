@@ -96,6 +96,11 @@ class LiveFleet
 	LiveFleetParams params_;
 	mutable std::mutex mutex_;
 	std::vector<Robot> robots_;
+	/** Bumped by every change of a map or a placement: merged() fuses again
+	 * only then (the node asks at merging_rate, maps change less often). */
+	size_t version_ = 0, merged_version_ = size_t(-1);
+	std::optional<nav_msgs::OccupancyGrid> merged_cache_;
+	std::string merged_why_, merged_frame_;
 	std::string world_robot_;
 	size_t estimations_ = 0;
 };
