@@ -493,14 +493,18 @@ int fleetChild(const std::string& dir)
 /** A fleet of `n` robots of fr079, each a 40 % share of the run spread over
  * it, at resolutions cycling over 5, 3, 8, 4, 6, 10, 2.5, 7 cm, in frames
  * turned by 37° more each, origins off the lattice, as map_server files;
- * `pad_to` > 0 pads each to that many cells a side; `other_building` adds
- * an intel robot that must stay out. Placed in a fresh process. */
-FleetCase runFleetCase(const std::string& self, const std::string& name, int n, int pad_to, bool other_building,
-					   double fixed_res = 0)
+ * `pad_to` > 0 pads each to that many cells a side. `beyond_reference` adds
+ * a robot (4 cm) that saw nothing the reference saw (it can only be placed
+ * through another robot); `other_building` an intel robot that must stay
+ * out. Placed in a fresh process. */
+FleetCase runFleetCase(const std::string& self, const std::string& name, int n, int pad_to, bool beyond_reference,
+					   bool other_building, double fixed_res = 0)
 {
 	FleetCase c;
 	c.name = name;
-	c.maps = n + other_building;
+	c.maps = n + beyond_reference + other_building;
+	c.building = n - 1 + beyond_reference;
+	const int other_index = other_building ? c.maps - 1 : -1;
 	const fs::path dir = fs::temp_directory_path() / ("multires_bench_fleet_" + std::to_string(getpid()));
 	fs::remove_all(dir);
 	fs::create_directories(dir);
@@ -510,14 +514,16 @@ FleetCase runFleetCase(const std::string& self, const std::string& name, int n, 
 	std::vector<GridInFrame> written;
 	for (int i = 0; i < c.maps; ++i)
 	{
-		const bool other = i == n;
+		const bool other = i == other_index, beyond = beyond_reference && i == n;
 		const ScanSequence& s = scansOf(other ? "intel" : "fr079");
-		const double r = fixed_res > 0 ? fixed_res : res_cycle[i % res_cycle.size()];
-		const double begin = other || n == 1 ? 0.0 : 0.6 * i / (n - 1);
+		const double r = beyond ? 0.04 : fixed_res > 0 ? fixed_res : res_cycle[i % res_cycle.size()];
+		const double begin = other || n == 1 ? 0.0 : beyond ? 0.45 : 0.6 * i / (n - 1);
+		const double end = beyond ? 1.0 : std::min(1.0, begin + 0.4);
 		const mrpt::poses::CPose2D frame = i == 0 || other ? mrpt::poses::CPose2D()
 														   : mrpt::poses::CPose2D(0.5 * i, -0.3 * i, (37.0 * i) * M_PI / 180);
-		GridInFrame g = renderGridOffLattice(
-			s, size_t(begin * s.size()), size_t(std::min(1.0, begin + 0.4) * s.size()), r, frame, 0.37 * r, 0.61 * r);
+		truth.push_back(Similarity2D(1, frame.phi(), {frame.x(), frame.y()}));
+		GridInFrame g = renderGridOffLattice(s, size_t(begin * s.size()), size_t(end * s.size()), r, frame, 0.37 * r, 0.61 * r);
+		if (beyond) forgetSeenBy(g, truth.back(), written[0], 1.0);
 		if (pad_to > 0)
 		{
 			const float cell = g.grid.getResolution();
@@ -525,10 +531,9 @@ FleetCase runFleetCase(const std::string& self, const std::string& name, int n, 
 			g.grid.resizeGrid(g.grid.getXMin(), g.grid.getXMin() + w * cell, g.grid.getYMin(), g.grid.getYMin() + h * cell, 0.5f, false);
 		}
 		saveGridMap(g, (dir / ("map_" + std::to_string(i) + ".yaml")).string());
-		truth.push_back(Similarity2D(1, frame.phi(), {frame.x(), frame.y()}));
 		res.push_back(r);
 		c.sizes += (i ? ", " : "") + std::to_string(g.grid.getSizeX()) + "×" + std::to_string(g.grid.getSizeY()) + " @ " +
-			num(r * 100, 1) + " cm";
+			num(r * 100, 1) + " cm" + (beyond ? " (beyond the reference)" : other ? " (another building)" : "");
 		written.push_back(loadGridMap((dir / ("map_" + std::to_string(i) + ".yaml")).string()));
 	}
 	const std::string out = (dir / "out.txt").string();
@@ -538,7 +543,6 @@ FleetCase runFleetCase(const std::string& self, const std::string& name, int n, 
 	waitpid(pid, &status, 0);
 	std::ifstream f(out);
 	double worst = 0;
-	c.building = n - 1;
 	for (std::string line; std::getline(f, line);)
 	{
 		std::istringstream in(line.substr(line.find(' ') + 1));
@@ -554,7 +558,7 @@ FleetCase runFleetCase(const std::string& self, const std::string& name, int n, 
 			double sc = 1, yaw = 0, x = 0, y = 0;
 			in >> i >> placed >> sc >> yaw >> x >> y;
 			if (i == 0 || !placed) continue;
-			if (i >= n)
+			if (i == other_index)
 			{
 				++c.others_placed;
 				continue;
@@ -577,11 +581,11 @@ std::vector<FleetCase> runFleets(const std::string& self, bool quick)
 {
 	std::vector<FleetCase> cases;
 	for (int n : quick ? std::vector<int>{3} : std::vector<int>{2, 3, 4, 5, 6, 7, 8})
-		cases.push_back(runFleetCase(self, "N = " + std::to_string(n), n, 0, false));
+		cases.push_back(runFleetCase(self, "N = " + std::to_string(n), n, 0, false, false));
 	if (!quick)
 	{
-		cases.push_back(runFleetCase(self, "5 / 3 / 8 cm + another building (4 cm)", 3, 0, true));
-		cases.push_back(runFleetCase(self, "8 maps of 1000×1000 cells", 8, 1000, false, 0.05));
+		cases.push_back(runFleetCase(self, "5 / 3 / 8 cm, one 4 cm beyond the reference, + another building", 3, 0, true, true));
+		cases.push_back(runFleetCase(self, "8 maps of 1000×1000 cells", 8, 1000, false, false, 0.05));
 	}
 	return cases;
 }

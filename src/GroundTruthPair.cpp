@@ -10,6 +10,8 @@
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/poses/CPose3DPDF.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -170,6 +172,22 @@ double pointRmse(
 	double sum = 0;
 	for (const auto& p : points) sum += (estimate(p) - truth(p)).squaredNorm();
 	return std::sqrt(sum / static_cast<double>(points.size()));
+}
+
+void forgetSeenBy(GridInFrame& map, const Similarity2D& map_to_seen, const GridInFrame& seen, double margin_m)
+{
+	cv::Mat known = toClassImage(seen.grid) != kUnknown;
+	const int margin = static_cast<int>(std::ceil(margin_m / seen.grid.getResolution()));
+	cv::dilate(known, known, cv::Mat::ones(2 * margin + 1, 2 * margin + 1, CV_8UC1));
+	const Similarity2D to_seen_cells = seen.cellToMapFrame().inverse().compose(map_to_seen).compose(map.cellToMapFrame());
+	for (int y = 0; y < int(map.grid.getSizeY()); ++y)
+		for (int x = 0; x < int(map.grid.getSizeX()); ++x)
+		{
+			const Eigen::Vector2d q = to_seen_cells(Eigen::Vector2d(x, y));
+			const int qx = int(std::lround(q.x())), qy = int(std::lround(q.y()));
+			if (qx >= 0 && qy >= 0 && qx < known.cols && qy < known.rows && known.at<uint8_t>(qy, qx))
+				map.grid.setCell(x, y, 0.5f);
+		}
 }
 
 }  // namespace multires_map_merge

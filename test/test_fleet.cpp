@@ -62,21 +62,7 @@ Robot writeRobot(
 	const size_t n = s.size();
 	Robot r{tmpDir() + "/" + name + ".yaml", res, Similarity2D(1, frame.phi(), {frame.x(), frame.y()})};
 	GridInFrame map = renderGridOffLattice(s, size_t(begin * n), size_t(end * n), res, frame, dx * res, dy * res);
-	if (unseen_by)  // unseen_by's map frame is the run's (the reference's)
-	{
-		cv::Mat seen = toClassImage(unseen_by->grid) != kUnknown;
-		const int margin = static_cast<int>(std::ceil(1.0 / unseen_by->grid.getResolution()));
-		cv::dilate(seen, seen, cv::Mat::ones(2 * margin + 1, 2 * margin + 1, CV_8UC1));
-		const Similarity2D to_seen = unseen_by->cellToMapFrame().inverse().compose(r.truth).compose(map.cellToMapFrame());
-		for (int y = 0; y < int(map.grid.getSizeY()); ++y)
-			for (int x = 0; x < int(map.grid.getSizeX()); ++x)
-			{
-				const Eigen::Vector2d q = to_seen(Eigen::Vector2d(x, y));
-				const int qx = int(std::lround(q.x())), qy = int(std::lround(q.y()));
-				if (qx >= 0 && qy >= 0 && qx < seen.cols && qy < seen.rows && seen.at<uint8_t>(qy, qx))
-					map.grid.setCell(x, y, 0.5f);
-			}
-	}
+	if (unseen_by) forgetSeenBy(map, r.truth, *unseen_by, 1.0);  // unseen_by's map frame is the run's
 	saveGridMap(map, r.file);
 	return r;
 }

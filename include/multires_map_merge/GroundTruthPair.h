@@ -90,4 +90,10 @@ double pointRmse(
 	const Similarity2D& estimate, const Similarity2D& truth,
 	const std::vector<Eigen::Vector2d>& points);
 
+/** Makes unknown every cell of `map` within `margin_m` of what `seen` knows
+ * (`map_to_seen`: map's frame → seen's map frame): a robot that explored
+ * only beyond another one, for fleets where a robot overlaps only a
+ * non-reference robot. */
+void forgetSeenBy(GridInFrame& map, const Similarity2D& map_to_seen, const GridInFrame& seen, double margin_m);
+
 }  // namespace multires_map_merge
