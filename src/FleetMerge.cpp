@@ -145,12 +145,14 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 			if (disagreementCells(maps[e.from], maps[e.to], predicted, e.from_to_to) > tol) contradicted = int(k);
 		}
 		if (contradicted < 0) return t;
-		// The cycle: this edge and both paths to the reference (their common
-		// part cancels, but the weakest edge is what we drop either way, and a
-		// shared edge is as suspect as any).
-		std::vector<int> cycle = pathEdges(t, edges[contradicted].from);
-		for (int k : pathEdges(t, edges[contradicted].to)) cycle.push_back(k);
-		cycle.push_back(contradicted);
+		// The cycle: this edge and both tree paths up to where they meet (the
+		// part they share towards the reference is not on the cycle).
+		const std::vector<int> up_from = pathEdges(t, edges[contradicted].from), up_to = pathEdges(t, edges[contradicted].to);
+		std::vector<int> cycle = {contradicted};
+		for (const auto* path : {&up_from, &up_to})
+			for (int k : *path)
+				if (std::count(up_from.begin(), up_from.end(), k) + std::count(up_to.begin(), up_to.end(), k) == 1)
+					cycle.push_back(k);
 		const int weakest = *std::min_element(cycle.begin(), cycle.end(), [&](int a, int b) {
 			return edges[a].confidence < edges[b].confidence;
 		});
@@ -162,44 +164,18 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 }
 }  // namespace
 
-FleetResult placeFleet(
-	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
-	const FleetParams& params)
+FleetResult placeFromPairs(
+	const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge> edges, const FleetParams& params)
 {
-	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
-	const size_t n = maps.size();
+	for (const auto& e : edges)
+		if (e.from >= maps.size() || e.to >= maps.size() || e.from == e.to)
+			throw std::invalid_argument("a pair names a map that is not there");
 	FleetResult out;
-	std::map<std::pair<size_t, size_t>, bool> aligned;  // unordered pair → done
-	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
-
-	// Round 1: everything against the reference (the two-map case exactly).
-	PairList todo;
-	for (size_t k = 0; k < n; ++k)
-		if (k != reference) todo.emplace_back(reference, k);
-	Tree tree;
-	while (!todo.empty())
-	{
-		for (auto& e : alignPairs(maps, todo, aligner, params.threads)) out.edges.push_back(std::move(e));
-		for (const auto& [a, b] : todo) aligned[key(a, b)] = true;
-		out.pairs_aligned += todo.size();
-		tree = consistentTree(maps, reference, out.edges, params.cycle_tolerance_cells);
-		// Next round: the pairs that can still matter, those with a map that is
-		// not yet placed surely (a better path, or a first one, may go through
-		// any other map). Placed maps go first: they can carry a new one.
-		todo.clear();
-		auto settled = [&](size_t m) { return tree.maps[m].placed && tree.maps[m].confidence >= params.settled_confidence; };
-		for (size_t a = 0; a < n; ++a)
-			for (size_t b = a + 1; b < n; ++b)
-			{
-				if (aligned.count(key(a, b)) || (settled(a) && settled(b))) continue;
-				const bool b_first = tree.maps[b].placed && !tree.maps[a].placed;
-				todo.emplace_back(b_first ? b : a, b_first ? a : b);
-			}
-	}
-	out.pairs_skipped = n * (n - 1) / 2 - out.pairs_aligned;
+	const Tree tree = consistentTree(maps, reference, edges, params.cycle_tolerance_cells);
+	out.edges = std::move(edges);
 	out.maps = tree.maps;
-	for (size_t m = 0; m < n; ++m)
+	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		if (out.maps[m].placed) continue;
 		// Say why: the most confident pair this map had, and its reason.
@@ -212,6 +188,48 @@ FleetResult placeFleet(
 			why << " (closest: map " << (best->from == m ? best->to : best->from) << ", " << best->message << ")";
 		out.maps[m].message = why.str();
 	}
+	return out;
+}
+
+FleetResult placeFleet(
+	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
+	const FleetParams& params)
+{
+	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
+	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
+	const size_t n = maps.size();
+	std::vector<FleetEdge> edges;
+	std::map<std::pair<size_t, size_t>, bool> aligned;  // unordered pair → done
+	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+
+	// Round 1: everything against the reference (the two-map case exactly).
+	PairList todo;
+	for (size_t k = 0; k < n; ++k)
+		if (k != reference) todo.emplace_back(reference, k);
+	FleetResult out;
+	size_t pairs_aligned = 0;
+	while (!todo.empty())
+	{
+		for (auto& e : alignPairs(maps, todo, aligner, params.threads)) edges.push_back(std::move(e));
+		for (const auto& [a, b] : todo) aligned[key(a, b)] = true;
+		pairs_aligned += todo.size();
+		out = placeFromPairs(maps, reference, edges, params);
+		edges = out.edges;  // with the dropped marks
+		// Next round: the pairs that can still matter, those with a map that is
+		// not yet placed surely (a better path, or a first one, may go through
+		// any other map). Placed maps go first: they can carry a new one.
+		todo.clear();
+		auto settled = [&](size_t m) { return out.maps[m].placed && out.maps[m].confidence >= params.settled_confidence; };
+		for (size_t a = 0; a < n; ++a)
+			for (size_t b = a + 1; b < n; ++b)
+			{
+				if (aligned.count(key(a, b)) || (settled(a) && settled(b))) continue;
+				const bool b_first = out.maps[b].placed && !out.maps[a].placed;
+				todo.emplace_back(b_first ? b : a, b_first ? a : b);
+			}
+	}
+	out.pairs_aligned = pairs_aligned;
+	out.pairs_skipped = n * (n - 1) / 2 - pairs_aligned;
 	return out;
 }
 

@@ -199,3 +199,77 @@ TEST(Fleet, RefusesTooFewMapsAndABadReference)
 	std::vector<GridInFrame> two(2);
 	EXPECT_THROW(placeFleet(two, 2, CScalingGridMapAligner()), std::invalid_argument);
 }
+
+namespace
+{
+/** Maps for the graph alone: 10 m × 10 m of unknown at 10 cm. */
+std::vector<GridInFrame> blankMaps(size_t n)
+{
+	std::vector<GridInFrame> maps(n);
+	for (auto& m : maps) m.grid.setSize(0, 10, 0, 10, 0.1f);
+	return maps;
+}
+
+FleetEdge edge(size_t from, size_t to, const Similarity2D& from_to_to, double confidence)
+{
+	FleetEdge e;
+	e.from = from, e.to = to, e.merged = true, e.from_to_to = from_to_to, e.confidence = confidence;
+	e.message = "merged";
+	return e;
+}
+
+void expectNear(const Similarity2D& a, const Similarity2D& b)
+{
+	EXPECT_NEAR(a.scale, b.scale, 1e-9);
+	EXPECT_NEAR(wrapToPi(a.yaw - b.yaw), 0, 1e-9);
+	EXPECT_NEAR((a.t - b.t).norm(), 0, 1e-9);
+}
+}  // namespace
+
+TEST(FleetGraph, AContradictedCycleDropsItsWeakestPairNotTheSharedPath)
+{
+	// Truth: map i's frame in map 0's.
+	const std::vector<Similarity2D> truth = {
+		{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1.25, -0.5, {-3, 4}), Similarity2D(0.8, 2.0, {5, -2})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	Similarity2D wrong = between(3, 2);
+	wrong.t += Eigen::Vector2d(5, 0);  // 50 cells off
+	// The path all share (0 <- 1) is the weakest pair: a cycle 1-2-3 closed by
+	// a wrong 2 <- 3 must drop that one, not the shared path.
+	const std::vector<FleetEdge> edges = {
+		edge(1, 0, between(1, 0), 0.55), edge(2, 1, between(2, 1), 0.97), edge(3, 1, between(3, 1), 0.96),
+		edge(3, 2, wrong, 0.6)};
+	const FleetResult r = placeFromPairs(blankMaps(4), 0, edges);
+	for (size_t m = 0; m < 4; ++m)
+	{
+		ASSERT_TRUE(r.maps[m].placed) << m << ": " << r.maps[m].message;
+		expectNear(r.maps[m].in_reference, truth[m]);
+	}
+	EXPECT_TRUE(r.edges[3].dropped);
+	EXPECT_FALSE(r.edges[0].dropped);
+	EXPECT_DOUBLE_EQ(r.maps[2].confidence, 0.55);  // as sure as the weakest pair on its path
+	EXPECT_EQ(r.maps[3].parent, 1);
+}
+
+TEST(FleetGraph, TheMostConfidentPathWinsAndAnUnconnectedMapIsNamed)
+{
+	const std::vector<Similarity2D> truth = {{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1, -0.5, {-3, 4})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	Similarity2D slightly_off = between(2, 0);
+	slightly_off.t += Eigen::Vector2d(0.15, 0);  // 1.5 cells: within the cycle tolerance, kept
+	std::vector<FleetEdge> edges = {edge(1, 0, between(1, 0), 1.0), edge(2, 1, between(2, 1), 0.9),
+									edge(2, 0, slightly_off, 0.7)};
+	FleetEdge refused;
+	refused.from = 3, refused.to = 0, refused.message = "alignment not confident enough (confidence 0.2 < 0.5)";
+	refused.confidence = 0;
+	edges.push_back(refused);
+	const FleetResult r = placeFromPairs(blankMaps(4), 0, edges);
+	ASSERT_TRUE(r.maps[2].placed);
+	EXPECT_EQ(r.maps[2].parent, 1);  // 0.9 through map 1 beats 0.7 directly
+	expectNear(r.maps[2].in_reference, truth[2]);
+	EXPECT_FALSE(r.edges[2].dropped);
+	EXPECT_FALSE(r.maps[3].placed);
+	EXPECT_NE(r.maps[3].message.find("not confident enough"), std::string::npos) << r.maps[3].message;
+	EXPECT_FALSE(r.allPlaced());
+	EXPECT_THROW(placeFromPairs(blankMaps(2), 0, {edge(5, 0, {}, 1)}), std::invalid_argument);
+}

@@ -57,6 +57,15 @@ struct FleetResult
 	bool allPlaced() const;
 };
 
+/** The placement from pairs already aligned (placeFleet's step after each
+ * round of alignments): the maximum spanning tree from the reference, cycles
+ * that contradict it broken at their weakest pair (marked `dropped`), and for
+ * every map not placed the reason. Throws std::invalid_argument on a
+ * reference or a pair naming a map out of range. */
+FleetResult placeFromPairs(
+	const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge> edges,
+	const FleetParams& params = {});
+
 /** Places every map in `maps[reference]`'s frame. Throws std::invalid_argument
  * on fewer than two maps or a reference out of range. */
 FleetResult placeFleet(
