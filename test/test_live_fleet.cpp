@@ -201,3 +201,22 @@ TEST(LiveFleet, KnownInitialPosesPlaceWithoutEstimating)
 	const Similarity2D origin = ros1::originOf(*merged);
 	EXPECT_NEAR(origin.yaw, 0.5, 1e-6);
 }
+
+TEST(LiveFleet, AFirstRobotThatOverlapsNoOneDoesNotHoldTheWorld)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	ros1::LiveFleet fleet({});
+	const auto& R = robots();
+	for (size_t i : {3, 0, 1}) fleet.addRobot(R[i].name);
+	for (size_t i : {3, 0, 1}) ASSERT_EQ(fleet.onMap(R[i].name, mapMsg(R[i], 0.5, 1)), "");  // another building first
+	EXPECT_EQ(fleet.worldRobot(), "/robot4");
+	fleet.estimate();
+	EXPECT_EQ(fleet.worldRobot(), "/robot1");  // the largest group's first robot
+	EXPECT_FALSE(statusOf(fleet, "/robot4").placed) << statusOf(fleet, "/robot4").message;
+	const auto s2 = statusOf(fleet, "/robot2");
+	ASSERT_TRUE(s2.placed) << s2.message;
+	EXPECT_LE(errorCells(mapMsg(R[1], 0.5, 1), R[1], s2.in_world), 2.0);
+	// Committed now: the world stays, whatever comes.
+	fleet.estimate();
+	EXPECT_EQ(fleet.worldRobot(), "/robot1");
+}

@@ -3,6 +3,8 @@
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <algorithm>
+#include <functional>
+#include <numeric>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -108,6 +110,32 @@ bool LiveFleet::agree(const GridInFrame& map, const Similarity2D& a, const Simil
 	return std::sqrt(se / 4) <= params_.agreement_cells * cell;
 }
 
+bool LiveFleet::worldCommitted() const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	return std::any_of(robots_.begin(), robots_.end(), [&](const Robot& r) { return r.placed && r.name != world_robot_; });
+}
+
+namespace
+{
+/** A member (the first in input order) of the largest group of maps that
+ * confident pairs connect, if that group has two maps or more; else -1. */
+int largestGroupMember(size_t n, const std::vector<FleetEdge>& edges)
+{
+	std::vector<size_t> parent(n);
+	std::iota(parent.begin(), parent.end(), 0);
+	std::function<size_t(size_t)> root = [&](size_t a) { return parent[a] == a ? a : parent[a] = root(parent[a]); };
+	for (const auto& e : edges)
+		if (e.merged && !e.dropped) parent[root(e.from)] = root(e.to);
+	std::vector<size_t> size(n, 0);
+	for (size_t i = 0; i < n; ++i) ++size[root(i)];
+	int best = -1;
+	for (size_t i = 0; i < n; ++i)
+		if (size[root(i)] >= 2 && (best < 0 || size[root(i)] > size[root(size_t(best))])) best = int(i);
+	return best;
+}
+}  // namespace
+
 void LiveFleet::estimate()
 {
 	// Snapshot under the lock; align without it (maps keep arriving).
@@ -139,6 +167,7 @@ void LiveFleet::estimate()
 	}
 	std::optional<FleetResult> result;
 	std::string failure;
+	bool world_moved = false;
 	if (maps.size() >= 2)
 	{
 		try
@@ -146,6 +175,21 @@ void LiveFleet::estimate()
 			CScalingGridMapAligner aligner;
 			aligner.options = params_.aligner;
 			result = placeFleet(maps, world, aligner);
+			// The world is provisional until a second robot is placed in it: if
+			// its robot overlaps no one (another building, a robot far away)
+			// while others overlap each other, the world moves to the largest
+			// group, on the pairs already aligned (placeFleet aligned them all,
+			// nobody being settled).
+			const bool alone = std::none_of(result->maps.begin(), result->maps.end(), [&](const FleetPlacement& p) {
+				return p.placed && &p != &result->maps[world];
+			});
+			if (alone && !worldCommitted())
+				if (const int better = largestGroupMember(maps.size(), result->edges); better >= 0 && size_t(better) != world)
+				{
+					world = size_t(better);
+					result = placeFromPairs(maps, world, result->edges);
+					world_moved = true;
+				}
 		}
 		catch (const std::exception& e)
 		{
@@ -154,6 +198,11 @@ void LiveFleet::estimate()
 	}
 	std::lock_guard<std::mutex> lock(mutex_);
 	++version_;  // placements may have changed
+	if (world_moved)
+	{
+		world_robot_ = names[world];
+		for (auto& r : robots_) r.placed = false, r.pending.reset();  // nobody else was placed yet
+	}
 	for (size_t i = 0; i < names.size(); ++i)
 	{
 		Robot& r = *find(names[i]);

@@ -8,8 +8,10 @@
 // good placement until a new one is confirmed. A new estimate that agrees
 // with the kept one (the maps grew) refines it at once; one that disagrees
 // must come out the same in two estimations in a row; a failed estimate
-// changes nothing. The world is the first robot's map frame that delivered a
-// map (or, with known initial poses, the frame the poses are given in).
+// changes nothing. The world is the map frame of the first robot that
+// delivered a map, until a second robot is placed in it: if that robot
+// overlaps no one while others overlap each other, the world moves to the
+// largest such group (with known initial poses: the frame the poses are in).
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/FleetMerge.h>
 
@@ -92,6 +94,8 @@ class LiveFleet
 	Robot* find(const std::string& name);
 	const Robot* find(const std::string& name) const;
 	bool agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const;
+	/** A robot besides the world's is placed: the world may no longer move. */
+	bool worldCommitted() const;
 
 	LiveFleetParams params_;
 	mutable std::mutex mutex_;
