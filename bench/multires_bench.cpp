@@ -312,6 +312,16 @@ struct ScalingCase
 	bool merged = false;
 };
 
+/** This process's peak resident memory: VmHWM is this process image's own
+ * peak (getrusage would inherit the spawning parent's across exec). */
+double peakRssMb()
+{
+	std::ifstream status("/proc/self/status");
+	for (std::string line; std::getline(status, line);)
+		if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024;
+	return NAN;
+}
+
 /** In the child: align two saved grids and print the time; the parent
  * reads the child's peak memory (maps + aligner, nothing else). */
 int scalingChild(const std::string& ref_path, const std::string& other_path)
@@ -321,14 +331,7 @@ int scalingChild(const std::string& ref_path, const std::string& other_path)
 	mrpt::system::CTicTac clock;
 	const auto r = aligner.alignScaled(ref, other);
 	const double seconds = clock.Tac();
-	// VmHWM is this process image's own peak (getrusage would inherit the
-	// spawning parent's across exec).
-	std::ifstream status("/proc/self/status");
-	std::string line;
-	double hwm_kb = 0;
-	while (std::getline(status, line))
-		if (line.rfind("VmHWM:", 0) == 0) hwm_kb = std::stod(line.substr(6));
-	std::cout << "SCALING " << seconds << " " << r.success << " " << hwm_kb / 1024 << std::endl;
+	std::cout << "SCALING " << seconds << " " << r.success << " " << peakRssMb() << std::endl;
 	return 0;
 }
 
@@ -475,12 +478,8 @@ int fleetChild(const std::string& dir)
 	const FleetResult r = placeFleet(maps, 0, CScalingGridMapAligner());
 	const FusedFleet fused = fuseFleet(maps, r, 0, maps[0].grid.getResolution());
 	const double seconds = clock.Tac();
-	std::ifstream status("/proc/self/status");
-	double hwm_kb = 0;
-	for (std::string line; std::getline(status, line);)
-		if (line.rfind("VmHWM:", 0) == 0) hwm_kb = std::stod(line.substr(6));
 	std::cout << std::setprecision(12) << "FLEET " << seconds << " " << r.pairs_aligned << " " << r.pairs_skipped << " "
-			  << hwm_kb / 1024 << " " << fused.merged.grid.getSizeX() << std::endl;
+			  << peakRssMb() << " " << fused.merged.grid.getSizeX() << std::endl;
 	for (size_t i = 0; i < r.maps.size(); ++i)
 	{
 		const auto& p = r.maps[i].in_reference;

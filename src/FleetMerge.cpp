@@ -17,6 +17,16 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
+double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b)
+{
+	const Similarity2D cells = map.cellToMapFrame();
+	const double w = map.grid.getSizeX() - 1, h = map.grid.getSizeY() - 1;
+	double se = 0;
+	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
+		se += (a(cells(c)) - b(cells(c))).squaredNorm();
+	return std::sqrt(se / 4);
+}
+
 namespace
 {
 using PairList = std::vector<std::pair<size_t, size_t>>;  // (to, from): `from` aligned onto `to`
@@ -60,20 +70,11 @@ std::vector<FleetEdge> alignPairs(
 	return out;
 }
 
-/** RMS over `from`'s grid corners of where two transforms of its frame put
- * them, in cells of the coarser map of the pair. */
+/** cornerRms in cells of the coarser map of the pair. */
 double disagreementCells(const GridInFrame& from, const GridInFrame& to, const Similarity2D& a, const Similarity2D& b)
 {
-	const Similarity2D cells = from.cellToMapFrame();
-	const double w = from.grid.getSizeX() - 1, h = from.grid.getSizeY() - 1;
-	double se = 0;
-	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
-	{
-		const Eigen::Vector2d p = cells(c);
-		se += (a(p) - b(p)).squaredNorm();
-	}
 	const double coarse = std::max<double>(to.grid.getResolution(), from.grid.getResolution() * a.scale);
-	return std::sqrt(se / 4) / coarse;
+	return cornerRms(from, a, b) / coarse;
 }
 
 struct Tree

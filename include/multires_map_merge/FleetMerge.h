@@ -57,6 +57,11 @@ struct FleetResult
 	bool allPlaced() const;
 };
 
+/** RMS distance (metres of the target frame) between where two transforms
+ * put the four corners of `map`'s grid: how far apart two placements of a
+ * map are. */
+double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
+
 /** The placement from pairs already aligned (placeFleet's step after each
  * round of alignments): the maximum spanning tree from the reference, cycles
  * that contradict it broken at their weakest pair (marked `dropped`), and for

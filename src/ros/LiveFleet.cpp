@@ -101,13 +101,7 @@ std::string LiveFleet::onUpdate(const std::string& robot, const map_msgs::Occupa
 
 bool LiveFleet::agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const
 {
-	const Similarity2D cells = map.cellToMapFrame();
-	const double w = map.grid.getSizeX() - 1, h = map.grid.getSizeY() - 1;
-	double se = 0;
-	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
-		se += (a(cells(c)) - b(cells(c))).squaredNorm();
-	const double cell = map.grid.getResolution() * std::max(a.scale, b.scale);
-	return std::sqrt(se / 4) <= params_.agreement_cells * cell;
+	return cornerRms(map, a, b) <= params_.agreement_cells * map.grid.getResolution() * std::max(a.scale, b.scale);
 }
 
 bool LiveFleet::worldCommitted() const

@@ -30,6 +30,15 @@ void answerEvenIfItThrows(Response& res, Body body)
 		res.message = std::string("not merged: ") + e.what();
 	}
 }
+
+/** A request's output_resolution: 0 (the reference's) or metres > 0. */
+double checkedOutputResolution(double requested)
+{
+	if (std::isfinite(requested) && requested >= 0) return requested;
+	std::ostringstream why;
+	why << "output_resolution must be 0 (the reference's) or metres > 0, not " << requested;
+	throw InvalidGridMessage(why.str());
+}
 }  // namespace
 
 MergeMapsService::MergeMapsService(const CScalingGridMapAligner::TConfigParams& params) : params_(params)
@@ -44,13 +53,7 @@ void MergeMapsService::merge(const MergeMaps::Request& req, MergeMaps::Response&
 	res = MergeMaps::Response();
 	res.success = false;
 	answerEvenIfItThrows(res, [&]() {
-		const double out_res_req = req.output_resolution;
-		if (!std::isfinite(out_res_req) || out_res_req < 0)
-		{
-			std::ostringstream why;
-			why << "output_resolution must be 0 (the reference's) or metres > 0, not " << out_res_req;
-			throw InvalidGridMessage(why.str());
-		}
+		const double out_res_req = checkedOutputResolution(req.output_resolution);
 		const GridInFrame ref = gridFromMsg(req.reference, "reference");
 		const GridInFrame other = gridFromMsg(req.other, "other");
 
@@ -96,13 +99,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 	const auto start = std::chrono::steady_clock::now();
 	res = MergeFleet::Response();
 	answerEvenIfItThrows(res, [&]() {
-		const double out_res_req = req.output_resolution;
-		if (!std::isfinite(out_res_req) || out_res_req < 0)
-		{
-			std::ostringstream why;
-			why << "output_resolution must be 0 (the reference's) or metres > 0, not " << out_res_req;
-			throw InvalidGridMessage(why.str());
-		}
+		const double out_res_req = checkedOutputResolution(req.output_resolution);
 		if (req.maps.size() < 2) throw InvalidGridMessage("maps: give at least two maps");
 		if (req.reference >= req.maps.size())
 			throw InvalidGridMessage(
