@@ -25,6 +25,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	MRPT_LOAD_CONFIG_VAR(pyramid_levels, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(feature_max_level_cells, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(sift_contrast_threshold, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(sift_edge_threshold, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(ratio_test, double, c, s);
@@ -38,6 +39,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(lambda, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_relative_tolerance, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(icp_coarse_points, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
@@ -60,6 +62,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 			why << name << " = " << v << " is outside [" << lo << ", " << hi << "]";
 	};
 	in("pyramid_levels", pyramid_levels, 1, 8);
+	in("feature_max_level_cells", feature_max_level_cells, 4096, 1e10);
 	in("sift_contrast_threshold", sift_contrast_threshold, 0, 1);
 	in("sift_edge_threshold", sift_edge_threshold, 1, 1e3);
 	in("ratio_test", ratio_test, 0.1, 1);
@@ -72,6 +75,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("lambda", lambda, 0, 100);
 	in("icp_max_iterations", icp_max_iterations, 1, 1e5);
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
+	in("icp_coarse_points", icp_coarse_points, 0, 1e9);
 	in("verify_tolerance", verify_tolerance, 0.5, 50);
 	in("verify_shift", verify_shift, 1, 1000);
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
@@ -88,6 +92,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	MRPT_SAVE_CONFIG_VAR_COMMENT(pyramid_levels, "Pyramid levels per map (each halves the size)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(feature_max_level_cells, "Larger pyramid levels are not searched for features");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(sift_contrast_threshold, "SIFT contrast threshold");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(sift_edge_threshold, "SIFT edge threshold");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(ratio_test, "Lowe's ratio test for feature matches");
@@ -101,6 +106,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
@@ -117,6 +123,7 @@ FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
 {
 	FeatureParams p;
 	p.pyramid_levels = pyramid_levels;
+	p.max_level_cells = feature_max_level_cells;
 	p.sift_contrast_threshold = sift_contrast_threshold;
 	p.sift_edge_threshold = sift_edge_threshold;
 	p.ratio_test = ratio_test;
@@ -134,21 +141,22 @@ TsICPParams CScalingGridMapAligner::TConfigParams::icpParams() const
 	p.lambda = lambda;
 	p.max_iterations = icp_max_iterations;
 	p.relative_tolerance = icp_relative_tolerance;
+	p.coarse_points = icp_coarse_points;
 	return p;
 }
 
 namespace
 {
-std::string checkGrid(const COccupancyGridMap2D& g, const char* which)
+std::string checkGrid(const COccupancyGridMap2D& g)
 {
 	std::ostringstream why;
 	const double res = g.getResolution();
 	if (!std::isfinite(res) || !(res > 0))
-		why << which << " map has an invalid resolution (" << res << ")";
+		why << "has an invalid resolution (" << res << ")";
 	else if (!std::isfinite(g.getXMin()) || !std::isfinite(g.getYMin()))
-		why << which << " map has a non-finite origin";
+		why << "has a non-finite origin";
 	else if (g.getSizeX() < 8 || g.getSizeY() < 8)
-		why << which << " map is too small (" << g.getSizeX() << "x" << g.getSizeY()
+		why << "is too small (" << g.getSizeX() << "x" << g.getSizeY()
 			<< " cells; at least 8x8 needed)";
 	return why.str();
 }
@@ -210,8 +218,61 @@ TsICPResult refineFromTheInside(
 }
 }  // namespace
 
+CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COccupancyGridMap2D& grid) const
+{
+	auto p = std::make_shared<TPreparedMap>();
+	p->resolution = grid.getResolution();
+	p->feature_params = options.featureParams();
+	if (!options.invalidReason().empty()) return p;  // alignScaled says why; nothing here is safe to run
+	if (std::string why = checkGrid(grid); !why.empty())
+	{
+		p->problem = std::move(why);
+		return p;
+	}
+	if (double(grid.getSizeX()) * grid.getSizeY() > options.max_map_cells)
+	{
+		std::ostringstream why;
+		why << "is too large (" << grid.getSizeX() << "x" << grid.getSizeY() << " cells > max_map_cells = "
+			<< options.max_map_cells << "); resample it coarser or raise max_map_cells (memory grows with it)";
+		p->problem = why.str();
+		return p;
+	}
+	p->cell_to_metric = cellToMetric(grid);
+
+	// 1. The map as an image; features over a resolution pyramid.
+	mrpt::system::CTicTac stage;
+	p->classes = toClassImage(grid);
+	// Said plainly here rather than as "no feature matches" later.
+	const int occupied = cv::countNonZero(p->classes == kOccupied), free = cv::countNonZero(p->classes == kFree);
+	if (occupied + free == 0) p->problem = "is all unknown: nothing to align";
+	else if (occupied == 0) p->problem = "has no occupied cells: nothing to align";
+	else if (free == 0) p->problem = "has no free cells: no walls to align";
+	if (!p->problem.empty()) return p;
+	p->features = extractPyramidFeatures(p->classes, p->feature_params);
+	p->stage_seconds["features"] = stage.Tac();
+
+	// 2. Edge points, and what the verification judges them against.
+	stage.Tic();
+	p->edges = edgePoints(p->classes);
+	p->field = occupancyField(p->classes);
+	p->stage_seconds["edges"] = stage.Tac();
+	return p;
+}
+
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const COccupancyGridMap2D& ref, const COccupancyGridMap2D& other) const
+{
+	mrpt::system::CTicTac total;
+	const PreparedMapPtr ref_map = prepare(ref), other_map = prepare(other);
+	TReturnInfo info = alignScaled(*ref_map, *other_map);
+	for (const auto* p : {ref_map.get(), other_map.get()})
+		for (const auto& [name, seconds] : p->stage_seconds) info.stage_seconds[name] += seconds;
+	info.executionTime = total.Tac();
+	return info;
+}
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
+	const TPreparedMap& ref, const TPreparedMap& other) const
 {
 	mrpt::system::CTicTac total, stage;
 	TReturnInfo info;
@@ -224,49 +285,26 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	};
 	if (const std::string why = options.invalidReason(); !why.empty())
 		return fail("invalid parameters: " + why);
-	for (const auto& why : {checkGrid(ref, "reference"), checkGrid(other, "other")})
-		if (!why.empty()) return fail(why);
-	for (const auto& [g, which] : {std::pair{&ref, "reference"}, std::pair{&other, "other"}})
-		if (double(g->getSizeX()) * g->getSizeY() > options.max_map_cells)
-		{
-			std::ostringstream why;
-			why << which << " map is too large (" << g->getSizeX() << "x" << g->getSizeY() << " cells > max_map_cells = "
-				<< options.max_map_cells << "); resample it coarser or raise max_map_cells (memory grows with it)";
-			return fail(why.str());
-		}
-
-	// 1. Maps as images; features over a resolution pyramid; RANSAC.
-	stage.Tic();
-	const cv::Mat ref_img = toClassImage(ref), other_img = toClassImage(other);
-	for (const auto& [img, which] : {std::pair{&ref_img, "reference"}, std::pair{&other_img, "other"}})
-	{
-		// Said plainly here rather than as "no feature matches" later.
-		const int occupied = cv::countNonZero(*img == kOccupied), free = cv::countNonZero(*img == kFree);
-		if (occupied + free == 0) return fail(std::string(which) + " map is all unknown: nothing to align");
-		if (occupied == 0) return fail(std::string(which) + " map has no occupied cells: nothing to align");
-		if (free == 0) return fail(std::string(which) + " map has no free cells: no walls to align");
-	}
+	for (const auto& [p, which] : {std::pair{&ref, "reference"}, std::pair{&other, "other"}})
+		if (!p->problem.empty()) return fail(std::string(which) + " map " + p->problem);
 	const FeatureParams fp = options.featureParams();
-	const auto ref_feats = extractPyramidFeatures(ref_img, fp);
-	const auto other_feats = extractPyramidFeatures(other_img, fp);
-	info.stage_seconds["features"] = stage.Tac();
+	if (!sameExtraction(fp, ref.feature_params) || !sameExtraction(fp, other.feature_params))
+		return fail("the maps were prepared with other feature options than this aligner's");
 
+	// 1. RANSAC on the features of every pair of pyramid levels.
 	stage.Tic();
 	std::optional<double> expected_scale;
-	if (options.use_resolution_metadata)
-		expected_scale = other.getResolution() / ref.getResolution();
-	auto hyps = featureHypotheses(
-		ref_feats, other_feats, fp, expected_scale, options.metadata_scale_tolerance);
+	if (options.use_resolution_metadata) expected_scale = other.resolution / ref.resolution;
+	auto hyps = featureHypotheses(ref.features, other.features, fp, expected_scale, options.metadata_scale_tolerance);
 	info.stage_seconds["ransac"] = stage.Tac();
 	info.hypotheses = hyps.size();
 
-	// 2. Edge points.
-	stage.Tic();
-	const PointList ref_edges = edgePoints(ref_img), other_edges = edgePoints(other_img);
-	const OccupancyField ref_field = occupancyField(ref_img), other_field = occupancyField(other_img);
+	// 2. Edge points (prepared).
+	const PointList &ref_edges = ref.edges, &other_edges = other.edges;
+	const OccupancyField &ref_field = ref.field, &other_field = other.field;
+	const cv::Mat &ref_img = ref.classes, &other_img = other.classes;
 	info.ref_edge_points = ref_edges.size();
 	info.other_edge_points = other_edges.size();
-	info.stage_seconds["edges"] = stage.Tac();
 	if (ref_edges.size() < 10 || other_edges.size() < 10)
 		return fail("too few occupied cells bordering free space to register the maps");
 
@@ -276,74 +314,74 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	double icp_s = 0, verify_s = 0;
 	bool have = false;
 	auto refineAll = [&](const std::vector<Hypothesis>& list) {
-	int budget = options.max_hypotheses;
-	for (const auto& h : list)
-	{
-		if (budget-- <= 0) break;
-		++info.hypotheses_refined;
-		stage.Tic();
-		const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
-		icp_s += stage.Tac();
-		if (!r.transform.isFinite() || !(r.transform.scale > 0)) continue;
-		if (expected_scale &&
-			std::abs(std::log(r.transform.scale / *expected_scale)) >
-				std::log1p(options.metadata_scale_tolerance))
-			continue;
+		int budget = options.max_hypotheses;
+		for (const auto& h : list)
+		{
+			if (budget-- <= 0) break;
+			++info.hypotheses_refined;
+			stage.Tic();
+			const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
+			icp_s += stage.Tac();
+			if (!r.transform.isFinite() || !(r.transform.scale > 0)) continue;
+			if (expected_scale &&
+				std::abs(std::log(r.transform.scale / *expected_scale)) >
+					std::log1p(options.metadata_scale_tolerance))
+				continue;
 
-		// 4. Judge on the cells, against chance (MapAgreement.h).
-		stage.Tic();
-		const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
-		const TwoWaySupport sup = twoWaySupport(
-			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
-		const Chance chance = chanceSupport(
-			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
-			options.verify_shift, options.verify_turn_deg);
-		verify_s += stage.Tac();
-		const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
-		const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
-		TCandidate cand;
-		cand.initial_cells = h.other_to_ref;
-		cand.cells = r.transform;
-		cand.overlap = r.overlap;
-		cand.rmse_coarse_cells = rmse_coarse;
-		cand.consistency = ag.consistency;
-		cand.tolerant_consistency = sup.consistency();
-		cand.chance_consistency = chance.consistency;
-		cand.support = sup.score();
-		cand.judged_points = sup.judged();
-		cand.score = cand.tolerant_consistency +
-			options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
-			std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
-		// Two ways to be sure: the maps coincide cell for cell, or (independent
-		// maps) their walls agree within the tolerance well above chance.
-		const double tolerant_conf = cand.judged_points < kMinJudgedPoints
-			? 0.0
-			: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
-		const double conf = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
-		cand.confidence = conf;
-		info.candidates.push_back(cand);
-		MRPT_LOG_DEBUG_STREAM(
-			"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
-						  << r.overlap << " rmse " << rmse_coarse << " tolerant consistency "
-						  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
-						  << cand.score << " conf " << conf);
-		if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
-			continue;
-		have = true;
-		info.cells = r.transform;
-		info.initial_cells = h.other_to_ref;
-		info.overlap = r.overlap;
-		info.objective = r.objective;
-		info.trimmed_rmse_coarse_cells = rmse_coarse;
-		info.consistency = cand.tolerant_consistency;
-		info.chance_consistency = cand.chance_consistency;
-		info.confidence = conf;
-		info.ransac_inliers = h.inliers;
-		info.ransac_matches = h.matches;
-		info.icp_iterations = r.iterations;
-		info.objective_history = r.objective_history;
-		if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
-	}
+			// 4. Judge on the cells, against chance (MapAgreement.h).
+			stage.Tic();
+			const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
+			const TwoWaySupport sup = twoWaySupport(
+				ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
+			const Chance chance = chanceSupport(
+				ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
+				options.verify_shift, options.verify_turn_deg);
+			verify_s += stage.Tac();
+			const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
+			const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
+			TCandidate cand;
+			cand.initial_cells = h.other_to_ref;
+			cand.cells = r.transform;
+			cand.overlap = r.overlap;
+			cand.rmse_coarse_cells = rmse_coarse;
+			cand.consistency = ag.consistency;
+			cand.tolerant_consistency = sup.consistency();
+			cand.chance_consistency = chance.consistency;
+			cand.support = sup.score();
+			cand.judged_points = sup.judged();
+			cand.score = cand.tolerant_consistency +
+				options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
+				std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
+			// Two ways to be sure: the maps coincide cell for cell, or (independent
+			// maps) their walls agree within the tolerance well above chance.
+			const double tolerant_conf = cand.judged_points < kMinJudgedPoints
+				? 0.0
+				: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
+			const double conf = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
+			cand.confidence = conf;
+			info.candidates.push_back(cand);
+			MRPT_LOG_DEBUG_STREAM(
+				"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
+							  << r.overlap << " rmse " << rmse_coarse << " tolerant consistency "
+							  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
+							  << cand.score << " conf " << conf);
+			if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
+				continue;
+			have = true;
+			info.cells = r.transform;
+			info.initial_cells = h.other_to_ref;
+			info.overlap = r.overlap;
+			info.objective = r.objective;
+			info.trimmed_rmse_coarse_cells = rmse_coarse;
+			info.consistency = cand.tolerant_consistency;
+			info.chance_consistency = cand.chance_consistency;
+			info.confidence = conf;
+			info.ransac_inliers = h.inliers;
+			info.ransac_matches = h.matches;
+			info.icp_iterations = r.iterations;
+			info.objective_history = r.objective_history;
+			if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
+		}
 	};
 	refineAll(hyps);
 	// Where no feature hypothesis convinces, the building's structure may
@@ -362,8 +400,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 		return fail(info.hypotheses ? "no hypothesis survived refinement"
 									: "no consistent feature matches or structure between the maps (do they overlap?)");
 
-	info.metric = cellToMetric(ref).compose(info.cells).compose(cellToMetric(other).inverse());
-	info.implied_resolution_other = info.cells.scale * ref.getResolution();
+	info.metric = ref.cell_to_metric.compose(info.cells).compose(other.cell_to_metric.inverse());
+	info.implied_resolution_other = info.cells.scale * ref.resolution;
 	info.executionTime = total.Tac();
 	if (info.confidence < options.min_confidence)
 	{

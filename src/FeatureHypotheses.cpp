@@ -10,14 +10,23 @@
 
 namespace multires_map_merge
 {
+bool sameExtraction(const FeatureParams& a, const FeatureParams& b)
+{
+	return a.pyramid_levels == b.pyramid_levels && a.min_level_size == b.min_level_size &&
+		a.max_level_cells == b.max_level_cells && a.sift_contrast_threshold == b.sift_contrast_threshold &&
+		a.sift_edge_threshold == b.sift_edge_threshold && a.unknown_as_free == b.unknown_as_free;
+}
+
 std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const FeatureParams& p)
 {
 	auto sift = cv::SIFT::create(0, 3, p.sift_contrast_threshold, p.sift_edge_threshold);
 	std::vector<LevelFeatures> levels;
-	for (int l = 0; l < p.pyramid_levels; ++l)
+	const double cells = double(classes.cols) * classes.rows;
+	for (int l = 0; int(levels.size()) < p.pyramid_levels; ++l)
 	{
 		const double f = std::ldexp(1.0, -l);
-		if (std::min(classes.cols, classes.rows) * f < p.min_level_size && l > 0) break;
+		if (cells * f * f > p.max_level_cells) continue;
+		if (std::min(classes.cols, classes.rows) * f < p.min_level_size && !levels.empty()) break;
 		cv::Mat img = l == 0 ? classes.clone() : resampleClasses(classes, f);
 		if (p.unknown_as_free) img.setTo(kFree, img == kUnknown);
 		LevelFeatures lf;

@@ -31,42 +31,69 @@ namespace
 {
 using PairList = std::vector<std::pair<size_t, size_t>>;  // (to, from): `from` aligned onto `to`
 
-/** Aligns each pair (to, from) on a small pool of threads, each with its own
- * aligner (same options): the aligner keeps logger state. */
-std::vector<FleetEdge> alignPairs(
-	const std::vector<GridInFrame>& maps, const PairList& pairs, const CScalingGridMapAligner& aligner,
-	unsigned threads)
+/** Runs work(k, aligner) for k in [0, count) on a small pool of threads,
+ * each with its own aligner (same options): the aligner keeps logger state. */
+template <class Work>
+void onThreads(size_t count, const CScalingGridMapAligner& aligner, unsigned threads, Work work)
 {
-	std::vector<FleetEdge> out(pairs.size());
 	std::atomic<size_t> next{0};
-	auto work = [&]() {
+	auto run = [&]() {
 		CScalingGridMapAligner local;
 		local.options = aligner.options;
 		local.setMinLoggingLevel(aligner.getMinLoggingLevel());
-		for (size_t k; (k = next++) < pairs.size();)
-		{
-			FleetEdge& e = out[k];
-			e.to = pairs[k].first, e.from = pairs[k].second;
-			try
-			{
-				const auto r = local.alignScaled(maps[e.to], maps[e.from]);
-				e.merged = r.success;
-				e.from_to_to = r.metric;
-				e.confidence = r.success ? r.confidence : 0.0;
-				e.message = r.message;
-			}
-			catch (const std::exception& ex)
-			{
-				e.message = ex.what();
-			}
-		}
+		for (size_t k; (k = next++) < count;) work(k, local);
 	};
 	if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-	const size_t n = std::min<size_t>(threads, pairs.size());
+	const size_t n = std::min<size_t>(threads, count);
 	std::vector<std::thread> pool;
-	for (size_t t = 1; t < n; ++t) pool.emplace_back(work);
-	work();
+	for (size_t t = 1; t < n; ++t) pool.emplace_back(run);
+	run();
 	for (auto& t : pool) t.join();
+}
+
+using PreparedMaps = std::vector<CScalingGridMapAligner::PreparedMapPtr>;
+
+/** Each map prepared once (most of a pair's time), in parallel. */
+PreparedMaps prepareAll(const std::vector<GridInFrame>& maps, const CScalingGridMapAligner& aligner, unsigned threads)
+{
+	PreparedMaps out(maps.size());
+	onThreads(maps.size(), aligner, threads, [&](size_t k, const CScalingGridMapAligner& local) {
+		try
+		{
+			out[k] = local.prepare(maps[k].grid);
+		}
+		catch (const std::exception& ex)  // out of memory, say: that map's pairs fail, the others go on
+		{
+			auto failed = std::make_shared<CScalingGridMapAligner::TPreparedMap>();
+			failed->problem = std::string("could not be prepared: ") + ex.what();
+			out[k] = failed;
+		}
+	});
+	return out;
+}
+
+/** Aligns each pair (to, from) of prepared maps in parallel. */
+std::vector<FleetEdge> alignPairs(
+	const std::vector<GridInFrame>& maps, const PreparedMaps& prepared, const PairList& pairs,
+	const CScalingGridMapAligner& aligner, unsigned threads)
+{
+	std::vector<FleetEdge> out(pairs.size());
+	onThreads(pairs.size(), aligner, threads, [&](size_t k, const CScalingGridMapAligner& local) {
+		FleetEdge& e = out[k];
+		e.to = pairs[k].first, e.from = pairs[k].second;
+		try
+		{
+			const auto r = local.alignScaled(*prepared[e.to], *prepared[e.from]);
+			e.merged = r.success;
+			e.from_to_to = betweenMapFrames(maps[e.to], r.metric, maps[e.from]);
+			e.confidence = r.success ? r.confidence : 0.0;
+			e.message = r.message;
+		}
+		catch (const std::exception& ex)
+		{
+			e.message = ex.what();
+		}
+	});
 	return out;
 }
 
@@ -209,9 +236,10 @@ FleetResult placeFleet(
 		if (k != reference) todo.emplace_back(reference, k);
 	FleetResult out;
 	size_t pairs_aligned = 0;
+	const PreparedMaps prepared = prepareAll(maps, aligner, params.threads);
 	while (!todo.empty())
 	{
-		for (auto& e : alignPairs(maps, todo, aligner, params.threads)) edges.push_back(std::move(e));
+		for (auto& e : alignPairs(maps, prepared, todo, aligner, params.threads)) edges.push_back(std::move(e));
 		for (const auto& [a, b] : todo) aligned[key(a, b)] = true;
 		pairs_aligned += todo.size();
 		out = placeFromPairs(maps, reference, edges, params);

@@ -84,25 +84,26 @@ Similarity2D fitSimilarity(
 }
 }  // namespace
 
-TsICPResult runTsICP(
-	const PointList& ref, const PointList& other, const Similarity2D& start,
-	const TsICPParams& p)
+namespace
 {
-	if (ref.size() < 3 || other.size() < 3)
-		throw std::invalid_argument("TsICP needs at least 3 points in each set");
-	if (!start.isFinite() || !(start.scale > 0))
-		throw std::invalid_argument("TsICP start transform must be finite with scale > 0");
-	if (!(p.xi_min > 0 && p.xi_min <= 1))
-		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
+/** ψ(ξ) of `t` on the pairs of every reference point. */
+double objectiveAt(const PointList& ref, const PointKDTree& other_tree, const Similarity2D& t, const TsICPParams& p)
+{
+	return trim(backwardPairs(ref, other_tree, t), p).objective;
+}
 
-	const PointKDTree other_tree(other);
+/** The iterations of TsICP on a fixed point set. */
+TsICPResult iterate(
+	const PointList& ref, const PointList& other, const PointKDTree& other_tree, const Similarity2D& start,
+	const TsICPParams& p, int max_iterations)
+{
 	TsICPResult r;
 	r.transform = start;
 	auto pairs = backwardPairs(ref, other_tree, r.transform);
 	Trimming t = trim(pairs, p);
 	r.objective_history.push_back(t.objective);
 
-	for (r.iterations = 1; r.iterations <= p.max_iterations; ++r.iterations)
+	for (r.iterations = 1; r.iterations <= max_iterations; ++r.iterations)
 	{
 		const Similarity2D candidate = fitSimilarity(ref, other, pairs, t.count);
 		auto candidate_pairs = backwardPairs(ref, other_tree, candidate);
@@ -118,10 +119,45 @@ TsICPResult runTsICP(
 		r.objective_history.push_back(t.objective);
 		if (gain <= p.relative_tolerance * t.objective) { r.converged = true; break; }
 	}
-	r.iterations = std::min(r.iterations, p.max_iterations);
+	r.iterations = std::min(r.iterations, max_iterations);
 	r.overlap = t.overlap;
 	r.objective = t.objective;
 	r.trimmed_mse = t.mse;
+	return r;
+}
+}  // namespace
+
+TsICPResult runTsICP(
+	const PointList& ref, const PointList& other, const Similarity2D& start,
+	const TsICPParams& p)
+{
+	if (ref.size() < 3 || other.size() < 3)
+		throw std::invalid_argument("TsICP needs at least 3 points in each set");
+	if (!start.isFinite() || !(start.scale > 0))
+		throw std::invalid_argument("TsICP start transform must be finite with scale > 0");
+	if (!(p.xi_min > 0 && p.xi_min <= 1))
+		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
+
+	const PointKDTree other_tree(other);
+	if (p.coarse_points <= 0 || ref.size() <= 2 * size_t(p.coarse_points))
+		return iterate(ref, other, other_tree, start, p, p.max_iterations);
+
+	// Coarse: every k-th reference point (edge points come row by row, so a
+	// stride samples the whole map).
+	const size_t stride = ref.size() / size_t(p.coarse_points);
+	PointList sample;
+	sample.reserve(ref.size() / stride + 1);
+	for (size_t k = 0; k < ref.size(); k += stride) sample.push_back(ref[k]);
+	const TsICPResult coarse = iterate(sample, other, other_tree, start, p, p.max_iterations);
+	// Fine: on all points, from the coarse result unless (rarely) it is worse
+	// there than the start.
+	const double at_start = objectiveAt(ref, other_tree, start, p);
+	const bool better = coarse.transform.isFinite() && objectiveAt(ref, other_tree, coarse.transform, p) <= at_start;
+	TsICPResult r = iterate(
+		ref, other, other_tree, better ? coarse.transform : start, p,
+		std::max(1, p.max_iterations - (better ? coarse.iterations : 0)));
+	if (better) r.objective_history.insert(r.objective_history.begin(), at_start);
+	r.iterations += coarse.iterations;
 	return r;
 }
 

@@ -111,6 +111,38 @@ TEST(Fr079, TheGroundTruthPairsOfThePaperAlign)
 	}
 }
 
+// A fleet prepares each map once and aligns it in several pairs: a prepared
+// pair must align exactly as the grids do, one map may serve both roles, and
+// maps prepared with other feature options are refused, not silently mixed.
+TEST(PreparedMaps, AlignAsTheGridsDoAndRefuseOtherFeatureOptions)
+{
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 30, 0.6});
+	CScalingGridMapAligner aligner;
+	const auto ref = aligner.prepare(pair.ref), other = aligner.prepare(pair.other);
+	ASSERT_TRUE(ref->problem.empty() && other->problem.empty());
+	const auto from_grids = aligner.alignScaled(pair.ref, pair.other);
+	const auto prepared = aligner.alignScaled(*ref, *other);
+	expectAccurate(pair, prepared);
+	EXPECT_EQ(prepared.cells.t, from_grids.cells.t);
+	EXPECT_EQ(prepared.cells.scale, from_grids.cells.scale);
+	EXPECT_EQ(prepared.confidence, from_grids.confidence);
+	EXPECT_EQ(prepared.stage_seconds.count("features"), 0u);  // paid once, in prepare
+	// Reused the other way round: the inverse transform.
+	const auto back = aligner.alignScaled(*other, *ref);
+	ASSERT_TRUE(back.success) << back.message;
+	EXPECT_NEAR(back.cells.scale * prepared.cells.scale, 1.0, 0.002);
+
+	CScalingGridMapAligner coarser;
+	coarser.options.feature_max_level_cells = 1e4;
+	const auto r = coarser.alignScaled(*ref, *other);
+	EXPECT_FALSE(r.success);
+	EXPECT_NE(r.message.find("prepared with other feature options"), std::string::npos) << r.message;
+	// A problem found while preparing names the map's role when aligned.
+	mrpt::maps::COccupancyGridMap2D tiny(0, 0.2, 0, 0.2, 0.05);
+	const auto t = aligner.alignScaled(*ref, *aligner.prepare(tiny));
+	EXPECT_EQ(t.message.rfind("other map is too small", 0), 0u) << t.message;
+}
+
 TEST(MetadataFree, WrongStatedResolutionIsRecovered)
 {
 	// The other map is really 8 cm but claims 5 cm: the implied resolution

@@ -132,6 +132,23 @@ TEST(FeatureHypotheses, PyramidFindsAFiveTimesScaleOnARealMap)
 	EXPECT_GT(hyps.front().inliers, 10);
 }
 
+TEST(FeatureHypotheses, LargeLevelsAreSkippedAndThePyramidGoesDeeper)
+{
+	const cv::Mat fine = realClasses(0.02);
+	FeatureParams p;
+	p.pyramid_levels = 3;
+	p.min_level_size = 16;
+	p.max_level_cells = double(fine.total()) / 4;  // level 0 is too large, level 1 just fits
+	const auto levels = extractPyramidFeatures(fine, p);
+	ASSERT_EQ(levels.size(), 3u);
+	EXPECT_DOUBLE_EQ(levels[0].scale, 0.5);
+	EXPECT_DOUBLE_EQ(levels[2].scale, 0.125);
+	for (const auto& l : levels) EXPECT_GT(l.descriptors.rows, 10);
+	// Keypoints are still in full-resolution cells: all inside the map.
+	for (const auto& q : levels[0].points)
+		EXPECT_TRUE(q.x > -1 && q.y > -1 && q.x < fine.cols && q.y < fine.rows) << q;
+}
+
 namespace
 {
 // A real pair at 5 and 10 cm, the second turned and shifted.

@@ -12,6 +12,7 @@
 
 #include <multires_map_merge/FeatureHypotheses.h>
 #include <multires_map_merge/GridInFrame.h>
+#include <multires_map_merge/MapAgreement.h>
 #include <multires_map_merge/Similarity2D.h>
 #include <multires_map_merge/TsICP.h>
 
@@ -20,6 +21,7 @@
 #include <mrpt/slam/CMetricMapsAlignmentAlgorithm.h>
 
 #include <map>
+#include <memory>
 #include <string>
 
 namespace multires_map_merge
@@ -33,6 +35,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	{
 		// --- Features and RANSAC (initial hypotheses)
 		int pyramid_levels = 4;  //!< per map; each level halves the cell count per axis
+		/** Pyramid levels larger than this are not searched for features
+		 * (FeatureParams::max_level_cells): bounds the time and memory of SIFT. */
+		double feature_max_level_cells = 1 << 18;
 		double sift_contrast_threshold = 0.04;
 		double sift_edge_threshold = 10;
 		double ratio_test = 0.8;
@@ -49,6 +54,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double lambda = 2.0;
 		int icp_max_iterations = 100;
 		double icp_relative_tolerance = 1e-7;
+		int icp_coarse_points = 0;   //!< TsICPParams::coarse_points
 		// --- Decision (README "How the decision works"; calibrated by
 		// scripts/calibrate_decision.py on Halmstad E5/HIH and CARMEN negatives)
 		/** Walls within this many cells of the coarser map agree: independent
@@ -138,11 +144,40 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		std::map<std::string, double> stage_seconds;  //!< features, ransac, edges, icp, verify
 	};
 
+	/** One map as the aligner sees it: its class image, feature pyramid,
+	 * edge points and occupancy field. Preparing is most of an alignment's
+	 * time, and a map in a fleet takes part in several pairs: prepare it
+	 * once, align it in each. Valid with the options it was prepared with
+	 * (alignScaled refuses maps prepared with other feature options). */
+	struct TPreparedMap
+	{
+		/** Why this map cannot be aligned, after "reference map " or "other
+		 * map " ("" when it can): no structure, too small or too large. */
+		std::string problem;
+		double resolution = 0;  //!< as stated
+		Similarity2D cell_to_metric;  //!< the grid's cells → its metric frame
+		cv::Mat classes;  //!< GridImage.h
+		FeatureParams feature_params;  //!< those the features were extracted with
+		std::vector<LevelFeatures> features;
+		PointList edges;
+		OccupancyField field;
+		std::map<std::string, double> stage_seconds;  //!< features, edges
+	};
+	using PreparedMapPtr = std::shared_ptr<const TPreparedMap>;
+
+	/** Prepares one map with these options. Never throws on bad content:
+	 * the map's `problem` says what is wrong. */
+	PreparedMapPtr prepare(const mrpt::maps::COccupancyGridMap2D& grid) const;
+
 	/** The full similarity between two grids. Never throws on bad map
 	 * content: the reason is in TReturnInfo::message with success = false. */
 	TReturnInfo alignScaled(
 		const mrpt::maps::COccupancyGridMap2D& ref,
 		const mrpt::maps::COccupancyGridMap2D& other) const;
+
+	/** The same for prepared maps (TReturnInfo::stage_seconds then holds the
+	 * pair's stages only; executionTime excludes the preparation). */
+	TReturnInfo alignScaled(const TPreparedMap& ref, const TPreparedMap& other) const;
 
 	/** The same for maps held in their exact frames (map_server files, ROS
 	 * messages; MapIO, OccupancyGridConversion): TReturnInfo::metric is then

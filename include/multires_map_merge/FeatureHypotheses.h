@@ -22,6 +22,12 @@ struct FeatureParams
 {
 	int pyramid_levels = 4;  //!< levels per map, each half the previous size
 	int min_level_size = 64;  //!< cells; smaller levels are skipped
+	/** Levels with more cells are skipped (the pyramid then starts lower and
+	 * still keeps `pyramid_levels` levels): SIFT doubles its first octave, so
+	 * a large map's full-resolution level costs most of the time and memory
+	 * of the whole alignment, and the seeds it finds are no better than a
+	 * coarser level's (TsICP refines on the full-resolution edges anyway). */
+	double max_level_cells = 1 << 18;
 	double sift_contrast_threshold = 0.04;
 	double sift_edge_threshold = 10;
 	double ratio_test = 0.8;  //!< Lowe's ratio for accepting a match
@@ -51,6 +57,10 @@ struct LevelFeatures
 	std::vector<cv::Point2f> points;  //!< full-resolution cell coordinates
 	cv::Mat descriptors;
 };
+
+/** Whether two parameter sets extract the same features (the matching and
+ * RANSAC parameters may differ). */
+bool sameExtraction(const FeatureParams& a, const FeatureParams& b);
 
 /** SIFT on every pyramid level of a class image. */
 std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const FeatureParams& p);

@@ -19,6 +19,11 @@ struct TsICPParams
 	int max_iterations = 100;
 	/** Stops when ψ improves by less than this fraction of itself. */
 	double relative_tolerance = 1e-7;
+	/** Coarse to fine: with more reference points than twice this, TsICP
+	 * first converges on every k-th of them (about this many), then finishes
+	 * on all. Most iterations run from afar, where a sample moves the
+	 * transform as well as all points do. 0: all points throughout. */
+	int coarse_points = 0;
 };
 
 struct TsICPResult
@@ -27,9 +32,11 @@ struct TsICPResult
 	double overlap = 0;  //!< the ξ of the last iteration
 	double objective = 0;  //!< ψ(ξ) of the final transform
 	double trimmed_mse = 0;  //!< e(ξ), squared ref units
-	int iterations = 0;
+	int iterations = 0;  //!< both phases (coarse_points)
 	bool converged = false;  //!< false if it stopped at max_iterations
-	/** ψ before each re-fit; history[0] is the start's. Non-increasing. */
+	/** ψ on all points before each full-resolution re-fit; history[0] is the
+	 * start's, history[1] the coarse phase's result when that phase ran (and
+	 * was no worse). Non-increasing. */
 	std::vector<double> objective_history;
 };
 
