@@ -201,8 +201,11 @@ int main(int argc, char** argv)
 		merging_nh.createTimer(ros::Duration(1.0 / s.merging_rate), [&](const ros::TimerEvent&) { publishMerged(); });
 	std::map<std::string, std::string> last_messages;
 	ros::Timer estimation_timer;
-	if (s.known_init_poses || s.estimation_rate == 0)
+	if (s.known_init_poses)  // no estimation: robots are placed at their poses as they appear
 		estimation_timer = estimation_nh.createTimer(ros::Duration(1.0), [&](const ros::TimerEvent&) { fleet->estimate(); });
+	else if (s.estimation_rate == 0)
+		ROS_WARN("map_merge: estimation_rate 0 without known_init_poses: no placement is estimated, so no robot "
+				 "will be merged (as in m-explore); set estimation_rate > 0 or known_init_poses true");
 	else
 		estimation_timer = estimation_nh.createTimer(ros::Duration(1.0 / s.estimation_rate), [&](const ros::TimerEvent&) {
 			fleet->estimate();
