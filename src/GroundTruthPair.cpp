@@ -164,6 +164,17 @@ COccupancyGridMap2D withStatedResolution(const COccupancyGridMap2D& grid, double
 	return out;
 }
 
+std::vector<Eigen::Vector2d> occupiedPointsInMapFrame(const GridInFrame& map)
+{
+	std::vector<cv::Point> cells;
+	cv::findNonZero(toClassImage(map.grid) == kOccupied, cells);
+	const Similarity2D to_frame = map.cellToMapFrame();
+	std::vector<Eigen::Vector2d> pts;
+	pts.reserve(cells.size());
+	for (const auto& c : cells) pts.push_back(to_frame(Eigen::Vector2d(c.x, c.y)));
+	return pts;
+}
+
 double pointRmse(
 	const Similarity2D& estimate, const Similarity2D& truth,
 	const std::vector<Eigen::Vector2d>& points)

@@ -93,12 +93,7 @@ const Fleet* fleet()
  * truth, in cells of the coarser of it and the reference. */
 double errorCoarseCells(const Fleet& f, size_t m, const Similarity2D& estimate)
 {
-	const GridInFrame& map = f.maps[m];
-	std::vector<cv::Point> cells;
-	cv::findNonZero(toClassImage(map.grid) == kOccupied, cells);
-	std::vector<Eigen::Vector2d> pts;
-	for (const auto& c : cells) pts.push_back(map.cellToMapFrame()(Eigen::Vector2d(c.x, c.y)));
-	return pointRmse(estimate, f.robots[m].truth, pts) / std::max(f.robots[0].resolution, f.robots[m].resolution);
+	return pointRmse(estimate, f.robots[m].truth, occupiedPointsInMapFrame(f.maps[m])) / std::max(f.robots[0].resolution, f.robots[m].resolution);
 }
 }  // namespace
 

@@ -58,13 +58,8 @@ const std::vector<RobotSpec>& robots()
  * coarser of its map and the world robot's. */
 double errorCells(const nav_msgs::OccupancyGrid& msg, const RobotSpec& r, const Similarity2D& in_world)
 {
-	const GridInFrame map = ros1::gridFromMsg(msg);
-	std::vector<cv::Point> cells;
-	cv::findNonZero(toClassImage(map.grid) == kOccupied, cells);
-	std::vector<Eigen::Vector2d> pts;
-	for (const auto& c : cells) pts.push_back(map.cellToMapFrame()(Eigen::Vector2d(c.x, c.y)));
 	const Similarity2D truth(1, r.frame.phi(), {r.frame.x(), r.frame.y()});
-	return pointRmse(in_world, truth, pts) / std::max(0.05, r.res);
+	return pointRmse(in_world, truth, occupiedPointsInMapFrame(ros1::gridFromMsg(msg))) / std::max(0.05, r.res);
 }
 
 ros1::LiveFleet::RobotStatus statusOf(const ros1::LiveFleet& f, const std::string& name)

@@ -6,6 +6,7 @@
 // garbage on the robots' topics must not take the node down.
 #include <multires_map_merge/FleetStatus.h>
 #include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/ros/FleetBag.h>
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
@@ -66,12 +67,8 @@ bool spinUntil(Pred done, double seconds)
  * in cells of the coarser of its map and robot1's. */
 double errorCells(const nav_msgs::OccupancyGrid& msg, const ros1::FleetBagRobot& r, const Similarity2D& est)
 {
-	const GridInFrame map = ros1::gridFromMsg(msg);
-	std::vector<cv::Point> cells;
-	cv::findNonZero(toClassImage(map.grid) == kOccupied, cells);
-	std::vector<Eigen::Vector2d> pts;
-	for (const auto& c : cells) pts.push_back(map.cellToMapFrame()(Eigen::Vector2d(c.x, c.y)));
-	return pointRmse(est, Similarity2D(1, r.frame.phi(), {r.frame.x(), r.frame.y()}), pts) / std::max(0.05, r.resolution);
+	const Similarity2D truth(1, r.frame.phi(), {r.frame.x(), r.frame.y()});
+	return pointRmse(est, truth, occupiedPointsInMapFrame(ros1::gridFromMsg(msg))) / std::max(0.05, r.resolution);
 }
 }  // namespace
 

@@ -90,6 +90,10 @@ double pointRmse(
 	const Similarity2D& estimate, const Similarity2D& truth,
 	const std::vector<Eigen::Vector2d>& points);
 
+/** The centres of `map`'s occupied cells in its map frame: the points a
+ * placement error is measured on. */
+std::vector<Eigen::Vector2d> occupiedPointsInMapFrame(const GridInFrame& map);
+
 /** Makes unknown every cell of `map` within `margin_m` of what `seen` knows
  * (`map_to_seen`: map's frame → seen's map frame): a robot that explored
  * only beyond another one, for fleets where a robot overlaps only a
