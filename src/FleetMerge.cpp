@@ -268,29 +268,14 @@ FusedFleet fuseFleet(
 {
 	if (placement.maps.size() != maps.size() || reference >= maps.size())
 		throw std::invalid_argument("fuseFleet: placement does not match the maps");
-	// One fusion per placed map into the growing result: each output cell
-	// keeps the cell rule (occupied if any, else free if any, else unknown).
-	GridInFrame merged = fuseGridMaps(maps[reference], maps[reference], Similarity2D(), output_resolution, max_cells).merged;
+	std::vector<std::optional<Similarity2D>> to_reference(maps.size());
 	for (size_t m = 0; m < maps.size(); ++m)
-		if (m != reference && placement.maps[m].placed)
-			merged = fuseGridMaps(merged, maps[m], placement.maps[m].in_reference, output_resolution, max_cells).merged;
+		if (m == reference || placement.maps[m].placed)
+			to_reference[m] = m == reference ? Similarity2D() : placement.maps[m].in_reference;
+	FusedMaps fused = fuseGridMaps(maps, reference, to_reference, output_resolution, max_cells);
 	FusedFleet out;
-	out.classes.resize(maps.size());
-	for (size_t m = 0; m < maps.size(); ++m)
-	{
-		if (!placement.maps[m].placed) continue;
-		const FusedMap f = fuseGridMaps(merged, maps[m], placement.maps[m].in_reference, output_resolution, max_cells);
-		// Both grids lie on merged's lattice in one frame; sub-cell sampling at
-		// the border may add a cell row that the picture can do without.
-		const double res = merged.grid.getResolution();
-		const int ox = static_cast<int>(std::lround((f.merged.grid.getXMin() - merged.grid.getXMin()) / res));
-		const int oy = static_cast<int>(std::lround((f.merged.grid.getYMin() - merged.grid.getYMin()) / res));
-		cv::Mat classes(int(merged.grid.getSizeY()), int(merged.grid.getSizeX()), CV_8UC1, cv::Scalar(kUnknown));
-		const cv::Rect into = cv::Rect(ox, oy, f.other_classes.cols, f.other_classes.rows) & cv::Rect(0, 0, classes.cols, classes.rows);
-		if (into.area() > 0) f.other_classes(into - cv::Point(ox, oy)).copyTo(classes(into));
-		out.classes[m] = classes;
-	}
-	out.merged = std::move(merged);
+	out.classes = std::move(fused.classes);
+	out.merged = std::move(fused.merged);
 	return out;
 }
 

@@ -87,6 +87,42 @@ TEST(Fusion, AOneCellWallSurvivesACoarserOutput)
 	EXPECT_EQ(classify(occAt(f.merged.grid, 1.0, 0.5)), kFree);
 }
 
+TEST(Fusion, ManyMapsInOnePassAnyReferenceOneLeftOut)
+{
+	// Three maps side by side in their own frames (origins rotated and off the
+	// lattice), the second the reference; the third is left out.
+	std::vector<GridInFrame> maps(3);
+	maps[0].grid = COccupancyGridMap2D(0, 1, 0, 1, 0.1f);
+	maps[1].grid = COccupancyGridMap2D(0, 1, 0, 1, 0.05f);
+	maps[2].grid = COccupancyGridMap2D(0, 1, 0, 1, 0.1f);
+	maps[1].origin = Similarity2D(1, 0.3, {0.013, -0.027});
+	setOcc(maps[0].grid, 0.55, 0.55, 0.9f);  // a wall in map 0 ...
+	setOcc(maps[1].grid, 0.52, 0.52, 0.1f);  // ... where map 1 (placed on it) sees free space
+	setOcc(maps[1].grid, 0.22, 0.22, 0.1f);
+	setOcc(maps[2].grid, 0.55, 0.55, 0.9f);
+	// Map 0 is placed so that its cell (0.55, 0.55) lands on map 1's (0.52, 0.52).
+	const Eigen::Vector2d target = maps[1].origin(Eigen::Vector2d(0.52, 0.52));
+	const Similarity2D zero_in_one(1, 0.8, target - Similarity2D(1, 0.8, {0, 0})(Eigen::Vector2d(0.55, 0.55)));
+	const FusedMaps f = fuseGridMaps(maps, 1, {zero_in_one, Similarity2D(), std::nullopt}, 0.05);
+	EXPECT_EQ(f.merged.origin.yaw, maps[1].origin.yaw);
+	ASSERT_EQ(f.classes.size(), 3u);
+	EXPECT_TRUE(f.classes[2].empty());
+	EXPECT_EQ(f.classes[0].size(), cv::Size(int(f.merged.grid.getSizeX()), int(f.merged.grid.getSizeY())));
+	// Occupied wins over free; the free cell of map 1 alone stays free.
+	const Similarity2D to_grid = f.merged.origin.inverse();
+	const Eigen::Vector2d wall = to_grid(target), free_cell = to_grid(maps[1].origin(Eigen::Vector2d(0.22, 0.22)));
+	EXPECT_EQ(classify(occAt(f.merged.grid, wall.x(), wall.y())), kOccupied);
+	EXPECT_EQ(classify(occAt(f.merged.grid, free_cell.x(), free_cell.y())), kFree);
+	// Map 2 contributed nothing: no second wall where its own would land.
+	size_t occupied = 0;
+	for (unsigned y = 0; y < f.merged.grid.getSizeY(); ++y)
+		for (unsigned x = 0; x < f.merged.grid.getSizeX(); ++x) occupied += classify(occupancyProbability(f.merged.grid, x, y)) == kOccupied;
+	EXPECT_GE(occupied, 1u);
+	EXPECT_LE(occupied, 4u);  // one 10 cm cell over at most 2x2 output cells
+	EXPECT_THROW(fuseGridMaps(maps, 1, {zero_in_one, std::nullopt, std::nullopt}, 0.05), std::invalid_argument);
+	EXPECT_THROW(fuseGridMaps(maps, 3, {zero_in_one, Similarity2D(), std::nullopt}, 0.05), std::invalid_argument);
+}
+
 TEST(Fusion, RefusesAbsurdSizesAndBadArguments)
 {
 	COccupancyGridMap2D a(0, 1, 0, 1, 0.1f);

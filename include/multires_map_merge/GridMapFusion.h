@@ -10,7 +10,9 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <opencv2/core.hpp>
 
+#include <optional>
 #include <stdexcept>
+#include <vector>
 
 namespace multires_map_merge
 {
@@ -50,6 +52,22 @@ FusedMap fuseGridMaps(
 FusedMap fuseGridMaps(
 	const GridInFrame& ref, const GridInFrame& other, const Similarity2D& other_to_ref,
 	double output_resolution, size_t max_cells = size_t(1) << 28);
+
+/** Any number of maps in their frames, in one pass (the cell rule is the same
+ * in any order): `to_reference[k]` places maps[k]'s frame in
+ * maps[reference]'s (std::nullopt leaves map k out; the reference's own is
+ * the identity). The merged grid is in the reference map's frame, as above;
+ * `classes[k]` is maps[k] sampled on it (empty when left out). Throws as the
+ * two-map fusion does, and std::invalid_argument when the sizes disagree. */
+struct FusedMaps
+{
+	GridInFrame merged;
+	std::vector<cv::Mat> classes;
+};
+FusedMaps fuseGridMaps(
+	const std::vector<GridInFrame>& maps, size_t reference,
+	const std::vector<std::optional<Similarity2D>>& to_reference, double output_resolution,
+	size_t max_cells = size_t(1) << 28);
 
 /** The cell rule on two occupancy probabilities (0.5 = unknown). */
 float fuseCell(float p_ref, float p_other);
