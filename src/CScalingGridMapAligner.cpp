@@ -188,9 +188,10 @@ double shareOnKnown(const PointList& points, const Similarity2D& t, const Occupa
 {
 	if (points.empty()) return 0;
 	size_t on = 0;
+	const Eigen::Matrix2d a = t.linear();
 	for (const auto& p : points)
 	{
-		const Eigen::Vector2d q = t(p);
+		const Eigen::Vector2d q = a * p + t.t;
 		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
 		on += x >= 0 && y >= 0 && x < target.known.cols && y < target.known.rows && target.known.at<uint8_t>(y, x);
 	}

@@ -48,12 +48,13 @@ std::vector<Pair> backwardPairs(
 	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref)
 {
 	const Similarity2D ref_to_other = other_to_ref.inverse();
+	const Eigen::Matrix2d a = ref_to_other.linear();  // once, not a sine and cosine per point
 	const double s2 = other_to_ref.scale * other_to_ref.scale;
 	std::vector<Pair> pairs(ref.size());
 #pragma omp parallel for schedule(static)
 	for (size_t j = 0; j < ref.size(); ++j)
 	{
-		const auto [i, d2] = other_tree.nearest(ref_to_other(ref[j]));
+		const auto [i, d2] = other_tree.nearest(a * ref[j] + ref_to_other.t);
 		pairs[j] = {s2 * d2, j, i};
 	}
 	std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
