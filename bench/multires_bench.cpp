@@ -40,6 +40,7 @@
 #include <sstream>
 
 #include "halmstad.h"
+#include "live_fleet.h"
 #include "mrpt_anchor.h"
 #include "plots.h"
 
@@ -308,8 +309,10 @@ struct ScalingCase
 {
 	int cells = 0;  //!< longer side of the reference map
 	double ref_res = 0, other_res = 0, seconds = 0, peak_mb = 0;
+	double process_seconds = 0;  //!< the whole child process: start, loading both files, aligning, exit
 	unsigned ref_w = 0, ref_h = 0;
 	bool merged = false;
+	std::string message;  //!< the aligner's
 };
 
 /** This process's peak resident memory: VmHWM is this process image's own
@@ -331,7 +334,7 @@ int scalingChild(const std::string& ref_path, const std::string& other_path)
 	mrpt::system::CTicTac clock;
 	const auto r = aligner.alignScaled(ref, other);
 	const double seconds = clock.Tac();
-	std::cout << "SCALING " << seconds << " " << r.success << " " << peakRssMb() << std::endl;
+	std::cout << "SCALING " << seconds << " " << r.success << " " << peakRssMb() << "\nMESSAGE " << r.message << std::endl;
 	return 0;
 }
 
@@ -437,10 +440,12 @@ ScalingCase runScalingCase(const std::string& self, int cells)
 				   cells / 2),
 			other_path);
 	}
+	const auto started = std::chrono::steady_clock::now();
 	const pid_t pid = spawnSelf({self, "--scaling-align", ref_path, "--scaling-other", other_path}, out);
 	if (pid < 0) throw std::runtime_error("cannot start " + self);
 	int status = 0;
 	waitpid(pid, &status, 0);
+	c.process_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 	std::ifstream f(out);
 	std::string line;
 	while (std::getline(f, line))
@@ -449,11 +454,62 @@ ScalingCase runScalingCase(const std::string& self, int cells)
 			std::istringstream in(line.substr(8));
 			in >> c.seconds >> c.merged >> c.peak_mb;
 		}
+		else if (line.rfind("MESSAGE ", 0) == 0)
+			c.message = line.substr(8);
 	if (!(c.seconds > 0)) throw std::runtime_error("scaling case " + cells_s + " failed (see " + out + ")");
 	fs::remove(ref_path), fs::remove(other_path);
 	std::cout << "scaling " << c.ref_w << "x" << c.ref_h << " cells: " << c.seconds << " s, peak " << c.peak_mb
 			  << " MB" << std::endl;
 	return c;
+}
+
+/** One same-resolution fr079 pair as whole processes: ours and MRPT's, each
+ * loading the two map_server files, aligning and exiting (median of 3). */
+struct WholeProcessRow
+{
+	double res = 0, ours_s = 0, mrpt_s = 0, ours_peak_mb = 0, mrpt_peak_mb = 0;
+	bool ours_merged = false, mrpt_aligned = false;
+};
+
+WholeProcessRow runWholeProcess(const std::string& self, double res)
+{
+	WholeProcessRow row;
+	row.res = res;
+	const fs::path dir = fs::temp_directory_path() / ("multires_bench_process_" + std::to_string(getpid()));
+	fs::create_directories(dir);
+	const std::string ref = (dir / "ref.yaml").string(), other = (dir / "other.yaml").string(), out = (dir / "out.txt").string();
+	saveGridMap(*mapServerFile("fr079", true, res, 0), ref);
+	saveGridMap(*mapServerFile("fr079", false, res, 0), other);
+	auto run = [&](const std::vector<std::string>& args, const char* tag, bool& ok, double& peak_mb) {
+		std::vector<double> times;
+		for (int k = 0; k < 3; ++k)
+		{
+			const auto t0 = std::chrono::steady_clock::now();
+			const pid_t pid = spawnSelf(args, out);
+			if (pid < 0) throw std::runtime_error("cannot start " + self);
+			int status = 0;
+			waitpid(pid, &status, 0);
+			times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+			std::ifstream f(out);
+			for (std::string line; std::getline(f, line);)
+				if (line.rfind(tag, 0) == 0)
+				{
+					std::istringstream in(line.substr(std::string(tag).size()));
+					double seconds = 0;
+					if (std::string(tag) == "SCALING ")
+						in >> seconds >> ok >> peak_mb;  // SCALING seconds merged peak
+					else
+						in >> ok;  // MRPT aligned seconds ...
+				}
+		}
+		return median(times);
+	};
+	double unused = 0;
+	row.ours_s = run({self, "--scaling-align", ref, "--scaling-other", other}, "SCALING ", row.ours_merged, row.ours_peak_mb);
+	row.mrpt_s = run({self, "--mrpt-align", ref, "--scaling-other", other}, "MRPT ", row.mrpt_aligned, unused);
+	fs::remove_all(dir);
+	std::cout << "whole process " << res * 100 << " cm: ours " << row.ours_s << " s, MRPT " << row.mrpt_s << " s" << std::endl;
+	return row;
 }
 
 // ---------------------------------------------------------------- fleets (child process)
@@ -990,6 +1046,7 @@ int main(int argc, char** argv)
 		if (fleet_arg.isSet())
 		{
 			writeFleetSection(std::cout, runFleets(fs::canonical("/proc/self/exe"), quick));
+			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 3 : 8));
 			return 0;
 		}
 		const auto started = std::chrono::steady_clock::now();
@@ -1040,11 +1097,16 @@ int main(int argc, char** argv)
 
 		// 4. Scaling with map size (fresh process each: its own peak memory).
 		std::vector<ScalingCase> scaling;
-		for (const int cells : quick ? std::vector<int>{500} : std::vector<int>{500, 1000, 2000, 4000})
+		for (const int cells : quick ? std::vector<int>{500} : std::vector<int>{500, 1000, 2000, 4000, 8000})
 			scaling.push_back(runScalingCase(fs::canonical("/proc/self/exe"), cells));
+		// 4a. Whole processes against MRPT's on the same-resolution pairs.
+		std::vector<WholeProcessRow> processes;
+		for (const double r : quick ? std::vector<double>{0.10} : res_all)
+			processes.push_back(runWholeProcess(fs::canonical("/proc/self/exe"), r));
 
 		// 4b. Fleets: N maps into one (fresh process each).
 		const std::vector<FleetCase> fleets = runFleets(fs::canonical("/proc/self/exe"), quick);
+		const LiveLatency live = runLiveLatency(scansOf, quick ? 3 : 8);
 
 		// 5. Basin of convergence of TsICP alone.
 		const std::vector<double> dyaws = quick ? std::vector<double>{-8, 0, 8}
@@ -1203,6 +1265,43 @@ int main(int argc, char** argv)
 				   << " |\n";
 			}
 		md << "\nMedian ratio ours/MRPT: **" << num(median(ratios), 2) << "**.\n";
+
+		md << "\n### Whole process, same-resolution pairs\n\nEach side in a fresh process that loads the two "
+			  "map_server files, aligns and exits (median of 3 runs, wall time).\n\n"
+			  "| pair | ours [s] | MRPT [s] | ours / MRPT | ours: merged | MRPT: aligned | our peak RSS [MB] |\n"
+			  "|---|---|---|---|---|---|---|\n";
+		double worst_process_ratio = 0;
+		for (const auto& p : processes)
+		{
+			const double ratio = p.ours_s / std::max(1e-9, p.mrpt_s);
+			worst_process_ratio = std::max(worst_process_ratio, ratio);
+			md << "| " << cm(p.res) << " cm | " << num(p.ours_s, 2) << " | " << num(p.mrpt_s, 2) << " | " << num(ratio, 2)
+			   << " | " << (p.ours_merged ? "yes" : "no") << " | " << (p.mrpt_aligned ? "yes" : "no") << " | "
+			   << num(p.ours_peak_mb, 0) << " |\n";
+		}
+
+		// Alignment time distributions (in-process, `seconds` of each pair).
+		auto quantile = [](std::vector<double> v, double q) -> double {
+			v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+			if (v.empty()) return NAN;
+			std::sort(v.begin(), v.end());
+			return v[std::min(v.size() - 1, size_t(std::ceil(q * v.size())) - (q > 0 ? 1 : 0))];
+		};
+		const auto fig8_secs = column(all, [](auto& r) { return r.set == "resolution" ? r.seconds : NAN; });
+		const auto fig9_secs = column(all, [](auto& r) { return r.set == "rotation" ? r.seconds : NAN; });
+		const auto mrpt_fig8_secs = column(all, [](auto& r) { return r.set == "resolution" && r.mrpt_ran ? r.mrpt_seconds : NAN; });
+		md << "\n### Alignment time distribution (in-process)\n\n| pairs | median [s] | p95 [s] | max [s] |\n|---|---|---|---|\n";
+		auto distribution = [&](const std::string& title, const std::vector<double>& v) {
+			md << "| " << title << " | " << num(quantile(v, 0.5), 2) << " | " << num(quantile(v, 0.95), 2) << " | "
+			   << num(quantile(v, 1.0), 2) << " |\n";
+		};
+		distribution("fr079 Fig. 8 (81 pairs)", fig8_secs);
+		distribution("fr079 Fig. 9 (45 pairs)", fig9_secs);
+		distribution("MRPT on the Fig. 8 pairs it runs (same resolution)", mrpt_fig8_secs);
+		std::vector<double> halmstad_secs_all;
+		for (const auto& h : halmstad)
+			if (h.positive) halmstad_secs_all.push_back(h.seconds);
+		distribution("Halmstad, every same-site sensor pair", halmstad_secs_all);
 		size_t mrpt_refused = 0, mrpt_diff = 0;
 		for (const auto& r : all)
 			if (r.set == "resolution" && r.ref_res != r.other_res && r.mrpt_ran)
@@ -1303,15 +1402,19 @@ int main(int argc, char** argv)
 
 		md << "\n## Scaling\n\nThe fr079 pair at finer and finer resolution, each map padded with unknown cells to a square "
 		  "(the other at half the reference's resolution, rotated 30°), aligned in a fresh process.\n\n"
-		  "| reference cells | other cells | runtime [s] | peak RSS [MB] | merged |\n|---|---|---|---|---|\n";
+		  "*Whole process*: the child from start to exit (loading both `.gridmap` files, aligning, exiting).\n\n"
+		  "| reference cells | other cells | alignment [s] | whole process [s] | peak RSS [MB] | merged |\n|---|---|---|---|---|---|\n";
 		for (const auto& c : scaling)
 			md << "| " << c.ref_w << "×" << c.ref_h << " (" << num(c.ref_res * 100, 2) << " cm) | "
-			   << c.ref_w / 2 << "×" << c.ref_h / 2 << " | " << num(c.seconds, 2) << " | " << num(c.peak_mb, 0) << " | "
-			   << (c.merged ? "yes" : "no") << " |\n";
-		if (scaling.size() >= 2)
+			   << c.ref_w / 2 << "×" << c.ref_h / 2 << " | " << num(c.seconds, 2) << " | " << num(c.process_seconds, 2)
+			   << " | " << num(c.peak_mb, 0) << " | " << (c.merged ? std::string("yes") : "no: " + c.message) << " |\n";
+		std::vector<ScalingCase> aligned_cases;
+		for (const auto& c : scaling)
+			if (c.merged) aligned_cases.push_back(c);
+		if (aligned_cases.size() >= 2)
 		{
-			const auto& a = scaling.front();
-			const auto& b = scaling.back();
+			const auto& a = aligned_cases.front();
+			const auto& b = aligned_cases.back();
 			const double dc = std::log(double(b.ref_w) * b.ref_h / (double(a.ref_w) * a.ref_h));
 			md << "\nFitted growth between the smallest and largest case: runtime ∝ cells^"
 			   << num(std::log(b.seconds / a.seconds) / dc, 2) << ", peak memory ∝ cells^"
@@ -1323,6 +1426,7 @@ int main(int argc, char** argv)
 			return std::count_if(b.begin(), b.end(), [](auto& c) { return c.converged; });
 		};
 		writeFleetSection(md, fleets);
+		writeLiveSection(md, live);
 
 		md << "\n## Basin of convergence of TsICP alone (Fig. 7 analogue)\n\n"
 		   << "TsICP started from the truth rotated by Δθ and scaled by Δs about the other map's centre; converged = "
@@ -1371,6 +1475,38 @@ int main(int argc, char** argv)
 					   c.placed_right == c.building && c.others_placed == 0);
 			if (c.name.find("1000×1000") != std::string::npos)
 				target("fleet of 8 maps of 1000×1000 cells in ≤ 3 s on 2 cores", num(c.seconds, 1) + " s", c.seconds <= 3);
+		}
+		{
+			int lag = 0;  // the worst, in estimations
+			for (const auto& r : live.robots)
+				if (!r.other_building && r.offline_step >= 0) lag = std::max(lag, r.live_step < 0 ? 99 : r.live_step - r.offline_step);
+			target("live node: merged map and TF within two estimation periods of the maps overlapping (placed ≤ 1 "
+				   "estimation after they can be merged, estimation + fusion within a period, never wrong)",
+				   "lag " + std::to_string(lag) + " estimation(s), " + num(live.max_estimate_s + live.max_merged_s, 2) +
+					   " s of " + num(live.period_s, 1) + " s",
+				   live.met());
+		}
+		{
+			// Issue 12: speed and memory.
+			target("whole process ≤ 1.0× MRPT on every same-resolution fr079 pair", "worst " + num(worst_process_ratio, 2) + "×",
+				   !processes.empty() && worst_process_ratio <= 1.0);
+			const double m8 = quantile(fig8_secs, 0.5), mm = quantile(mrpt_fig8_secs, 0.5), max8 = quantile(fig8_secs, 1.0);
+			target("Fig. 8 alignment time: median ≤ 1.3× MRPT's median, max ≤ 1.5 s",
+				   num(m8, 2) + " s vs MRPT " + num(mm, 2) + " s, max " + num(max8, 2) + " s", m8 <= 1.3 * mm && max8 <= 1.5);
+			if (!quick)
+				target("Halmstad pairs: median alignment time ≤ 0.4 s", num(quantile(halmstad_secs_all, 0.5), 2) + " s",
+					   quantile(halmstad_secs_all, 0.5) <= 0.4);
+			for (const auto& c : scaling)
+			{
+				if (c.cells == 4000)
+					target("4000×4000 in ≤ 3 s with peak RSS ≤ 1 GiB", num(c.seconds, 2) + " s, " + num(c.peak_mb, 0) + " MB",
+						   c.merged && c.seconds <= 3 && c.peak_mb <= 1024);
+				if (c.cells == 8000)
+					target("8000×8000 aligns or is refused clearly within 4 GiB",
+						   (c.merged ? "aligned" : "refused (" + c.message.substr(0, 40) + "…)") + std::string(", ") +
+							   num(c.peak_mb, 0) + " MB",
+						   (c.merged || c.message.find("too large") != std::string::npos) && c.peak_mb <= 4096);
+			}
 		}
 		target("zero false merges", std::to_string(false_merges) + " / " + std::to_string(negatives.size()), false_merges == 0);
 		if (!quick)
