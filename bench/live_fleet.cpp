@@ -4,6 +4,7 @@
 #include <multires_map_merge/ros/LiveFleet.h>
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -49,25 +50,55 @@ double errorCells(const GridInFrame& map, const LiveRobot& r, const Similarity2D
 }
 }  // namespace
 
-bool LiveLatency::met() const
+double LiveLatency::maxEstimateSeconds() const
 {
-	if (robots.empty() || max_estimate_s + max_merged_s > period_s) return false;
+	double m = 0;
+	for (const auto& e : estimations) m = std::max(m, e.estimate_s + e.merged_s);
+	return m;
+}
+
+double LiveLatency::medianEstimateSeconds() const
+{
+	std::vector<double> d;
+	for (const auto& e : estimations) d.push_back(e.estimate_s + e.merged_s);
+	if (d.empty()) return 0;
+	std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+	return d[d.size() / 2];
+}
+
+double LiveLatency::maxLatencySeconds() const
+{
+	double m = 0;
 	for (const auto& r : robots)
 	{
-		if (r.wrong_steps > 0) return false;
-		if (r.other_building) continue;
-		if (r.name == robots.front().name) continue;  // the world
-		if (r.offline_step >= 0 && (r.live_step < 0 || r.live_step > r.offline_step + 1)) return false;
+		if (r.other_building || &r == &robots.front() || r.can_merge_s < 0) continue;
+		if (r.placed_s < 0) return -1;
+		m = std::max(m, r.latencySeconds());
+	}
+	return m;
+}
+
+bool LiveLatency::met() const
+{
+	if (robots.empty() || estimations.empty()) return false;
+	for (const auto& r : robots)
+	{
+		if (r.wrong_estimations > 0) return false;
+		if (r.other_building || &r == &robots.front()) continue;
+		if (r.can_merge_s >= 0 && (r.placed_s < 0 || r.latencySeconds() > 2 * period_s)) return false;
 	}
 	return true;
 }
 
-LiveLatency runLiveLatency(const ScansOf& scans, int steps)
+LiveLatency runLiveLatency(const ScansOf& scans, int states)
 {
 	LiveLatency out;
-	out.steps = steps;
+	out.states = states;
 	const auto& robots = liveRobots();
-	ros1::LiveFleet live(ros1::LiveFleetParams{});
+	ros1::LiveFleetParams params;  // as the node sets them at its default rate
+	params.estimation_budget_s = ros1::defaultEstimationBudget(1.0 / out.period_s);
+	out.budget_s = params.estimation_budget_s;
+	ros1::LiveFleet live(params);
 	for (const auto& r : robots)
 	{
 		live.addRobot(r.name);
@@ -80,55 +111,86 @@ LiveLatency runLiveLatency(const ScansOf& scans, int steps)
 		row.what = what.str();
 		out.robots.push_back(row);
 	}
-	for (int step = 1; step <= steps; ++step)
+	// Every map state, and when the maps first can be merged (offline).
+	std::vector<std::vector<GridInFrame>> maps_at(states + 1);
+	for (int k = 1; k <= states; ++k)
 	{
-		std::vector<GridInFrame> maps;
-		for (size_t i = 0; i < robots.size(); ++i)
+		for (const auto& r : robots)
 		{
-			const auto& r = robots[i];
 			const auto& s = scans(r.log);
-			const double share = double(step) / steps;
+			const double share = double(k) / states;
 			const size_t b = size_t(r.begin * s.size()), e = size_t((r.begin + share * (r.end - r.begin)) * s.size());
-			maps.push_back(renderGridOffLattice(s, b, e, r.res, r.frame, 0.37 * r.res, 0.61 * r.res));
-			std_msgs::Header h;
-			h.frame_id = r.name + "/map";
-			h.stamp = ros::Time(step, 0);
-			const std::string why = live.onMap(r.name, ros1::msgFromGrid(maps.back(), h));
-			if (!why.empty()) throw std::runtime_error("live bench: " + r.name + ": " + why);
+			maps_at[k].push_back(renderGridOffLattice(s, b, e, r.res, r.frame, 0.37 * r.res, 0.61 * r.res));
 		}
-		// When the maps first can be merged: the offline fleet on this step's maps.
-		const FleetResult offline = placeFleet(maps, 0, CScalingGridMapAligner());
-		for (size_t i = 0; i < robots.size(); ++i)
-			if (offline.maps[i].placed && out.robots[i].offline_step < 0 &&
-				(robots[i].other_building || errorCells(maps[i], robots[i], offline.maps[i].in_reference) <= 2))
-				out.robots[i].offline_step = step;
+		const bool all_known = std::all_of(out.robots.begin() + 1, out.robots.end(), [](const LiveRobotRow& r) {
+			return r.other_building || r.can_merge_state >= 0;
+		});
+		if (all_known) continue;
+		const FleetResult offline = placeFleet(maps_at[k], 0, CScalingGridMapAligner());
+		for (size_t i = 1; i < robots.size(); ++i)
+			if (offline.maps[i].placed && out.robots[i].can_merge_state < 0 && !robots[i].other_building &&
+				errorCells(maps_at[k][i], robots[i], offline.maps[i].in_reference) <= 2)
+				out.robots[i].can_merge_state = k, out.robots[i].can_merge_s = (k - 1) * out.state_s;
+	}
 
+	// The node: an estimation every period, or right after the previous one
+	// when that took longer; it sees the maps that arrived before it started.
+	int fed = 0;
+	const double last_state_s = (states - 1) * out.state_s;
+	for (double start = 0, tick = 0;;)
+	{
+		const int state = std::min(states, 1 + int(std::floor(start / out.state_s + 1e-9)));
+		if (state != fed)
+		{
+			for (size_t i = 0; i < robots.size(); ++i)
+			{
+				std_msgs::Header h;
+				h.frame_id = robots[i].name + "/map";
+				h.stamp = ros::Time(state, 0);
+				const std::string why = live.onMap(robots[i].name, ros1::msgFromGrid(maps_at[state][i], h));
+				if (!why.empty()) throw std::runtime_error("live bench: " + robots[i].name + ": " + why);
+			}
+			fed = state;
+		}
+		LiveEstimationRow row;
+		row.start_s = start, row.state = state;
 		auto t0 = std::chrono::steady_clock::now();
 		live.estimate();
-		out.max_estimate_s = std::max(out.max_estimate_s, seconds(t0));
+		row.estimate_s = seconds(t0);
 		t0 = std::chrono::steady_clock::now();
 		std::string why;
 		live.merged("world", &why);
-		out.max_merged_s = std::max(out.max_merged_s, seconds(t0));
+		row.merged_s = seconds(t0);
+		const auto st = live.lastEstimation();
+		row.maps_prepared = st.maps_prepared, row.pairs_aligned = st.pairs_aligned;
+		row.pairs_reused = st.pairs_reused, row.pairs_deferred = st.pairs_deferred;
+		out.estimations.push_back(row);
+		const double published = start + row.estimate_s + row.merged_s;
 
 		if (live.worldRobot() != robots[0].name)
 			throw std::runtime_error("live bench: the world settled on " + live.worldRobot() + ", not " + robots[0].name);
 		const auto status = live.status();
 		for (size_t i = 0; i < robots.size(); ++i)
 		{
-			LiveRobotRow& row = out.robots[i];
+			LiveRobotRow& r = out.robots[i];
 			if (!status[i].placed)
 			{
-				row.final_error_cells = -1;
+				r.final_error_cells = -1;
 				continue;
 			}
-			const double e = errorCells(maps[i], robots[i], status[i].in_world);
+			const double e = errorCells(maps_at[state][i], robots[i], status[i].in_world);
 			const bool right = !robots[i].other_building && e <= 2;
-			row.wrong_steps += !right;
-			if (right && row.live_step < 0) row.live_step = step;
-			row.final_error_cells = e;
+			r.wrong_estimations += !right;
+			if (right && r.placed_s < 0) r.placed_s = published;
+			r.final_error_cells = e;
 		}
-		std::cout << "live step " << step << ": estimate " << out.max_estimate_s << " s (slowest so far)" << std::endl;
+		std::cout << "live t=" << start << " s, maps of state " << state << ": estimate " << row.estimate_s
+				  << " s, maps prepared " << st.maps_prepared << "/" << st.maps << ", pairs aligned " << st.pairs_aligned
+				  << ", reused " << st.pairs_reused << ", deferred " << st.pairs_deferred << std::endl;
+		// Run until the last maps have had two periods.
+		if (start >= last_state_s + 2 * out.period_s) break;
+		while (tick <= start) tick += out.period_s;
+		start = std::max(tick, published);
 	}
 	return out;
 }
@@ -136,25 +198,42 @@ LiveLatency runLiveLatency(const ScansOf& scans, int steps)
 void writeLiveSection(std::ostream& md, const LiveLatency& l)
 {
 	md << "\n## The live node's latency (LiveFleet, as the map_merge node runs it)\n\n"
-	   << "Four robots' maps grow over " << l.steps << " steps (at step k each covers k/" << l.steps
-	   << " of its share of the run), fed as `nav_msgs/OccupancyGrid` messages in their own frames, with one "
-	   << "estimation per step. *Can merge*: the first step at which `placeFleet` on that step's maps places the robot "
-	   << "right (within 2 coarse cells); *placed live*: the first step at which the live node has it placed right. "
-	   << "The node estimates every " << l.period_s << " s by default (`estimation_rate` 0.5 Hz).\n\n"
-	   << "| robot | map | can merge at step | placed live at step | steps placed wrong | final error [coarse cells] |\n"
-	   << "|---|---|---|---|---|---|\n";
-	auto step = [](int s) { return s < 0 ? std::string("never") : std::to_string(s); };
+	   << "Four robots' maps grow in " << l.states << " states, one every " << l.state_s
+	   << " s of simulated time (state k covers k/" << l.states
+	   << " of each robot's share of the run: the robots explore faster than real ones, so the maps change more "
+	   << "between estimations), fed as `nav_msgs/OccupancyGrid` messages in their own frames. The node estimates "
+	   << "every " << l.period_s << " s (`estimation_rate` 0.5 Hz, its default), or right after the previous "
+	   << "estimation if that took longer, with the estimation budget it sets by default (" << l.budget_s
+	   << " s: no pair starts later); each estimation takes the time it measures on this machine. *Can merge*: "
+	   << "when the first state arrived on which `placeFleet` places the robot right (within 2 coarse cells); "
+	   << "*published*: when the node's first estimation that has it placed right ends (its fusion included).\n\n"
+	   << "| robot | map | can merge at [s] | published at [s] | latency [s] | estimations placed wrong | final error [coarse cells] |\n"
+	   << "|---|---|---|---|---|---|---|\n";
+	auto time = [](double s) {
+		std::ostringstream o;
+		if (s < 0) o << "never";
+		else o << std::fixed << std::setprecision(1) << s;
+		return o.str();
+	};
 	for (const auto& r : l.robots)
 	{
+		const bool world = &r == &l.robots.front();
 		std::ostringstream err;
 		if (r.final_error_cells < 0) err << "not placed";
 		else err << std::fixed << std::setprecision(2) << r.final_error_cells;
-		md << "| " << r.name << (&r == &l.robots.front() ? " (world)" : "") << " | " << r.what << " | "
-		   << (&r == &l.robots.front() ? "–" : step(r.offline_step)) << " | "
-		   << (&r == &l.robots.front() ? "–" : step(r.live_step)) << " | " << r.wrong_steps << " | " << err.str() << " |\n";
+		md << "| " << r.name << (world ? " (world)" : "") << " | " << r.what << " | "
+		   << (world ? "–" : time(r.can_merge_s)) << " | " << (world ? "–" : time(r.placed_s)) << " | "
+		   << (world || r.latencySeconds() < 0 ? std::string("–") : time(r.latencySeconds())) << " | "
+		   << r.wrong_estimations << " | " << err.str() << " |\n";
 	}
-	md << "\nSlowest estimation " << std::fixed << std::setprecision(2) << l.max_estimate_s << " s, slowest fusion "
-	   << l.max_merged_s << " s, against a period of " << l.period_s << " s.\n";
+	size_t aligned = 0, reused = 0, deferred = 0, prepared = 0;
+	for (const auto& e : l.estimations)
+		aligned += e.pairs_aligned, reused += e.pairs_reused, deferred += e.pairs_deferred, prepared += e.maps_prepared;
+	md << "\n" << l.estimations.size() << " estimations; each (with its fusion) took median " << std::fixed
+	   << std::setprecision(2) << l.medianEstimateSeconds() << " s, max " << l.maxEstimateSeconds()
+	   << " s, against a period of " << l.period_s << " s. Over all of them: " << prepared << " maps prepared, "
+	   << aligned << " pairs aligned, " << reused << " earlier results reused (maps unchanged, or a refused pair whose "
+	   << "maps grew less than `retry_growth`), " << deferred << " pairs deferred past the budget.\n";
 }
 
 }  // namespace multires_bench

@@ -981,6 +981,7 @@ int main(int argc, char** argv)
 		"", "sets", "only these accuracy sets (resolution, other-logs, rotation), printing their medians", false, "",
 		"SETS", cmd);
 	TCLAP::SwitchArg fleet_arg("", "fleet-only", "only the fleet section (printed as markdown)", cmd);
+	TCLAP::SwitchArg live_arg("", "live-only", "only the live node's latency (printed as markdown)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
 	TCLAP::ValueArg<std::string> mrpt_child("", "mrpt-align", "internal: MRPT's aligner in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_ref("", "scaling-align", "internal: align in a fresh process", false, "", "REF", cmd);
@@ -1043,10 +1044,15 @@ int main(int argc, char** argv)
 		}
 		if (sets_arg.isSet())
 			return runAccuracySets(sets_arg.getValue());
+		if (live_arg.isSet())
+		{
+			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 4 : 16));
+			return 0;
+		}
 		if (fleet_arg.isSet())
 		{
 			writeFleetSection(std::cout, runFleets(fs::canonical("/proc/self/exe"), quick));
-			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 3 : 8));
+			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 4 : 16));
 			return 0;
 		}
 		const auto started = std::chrono::steady_clock::now();
@@ -1106,7 +1112,7 @@ int main(int argc, char** argv)
 
 		// 4b. Fleets: N maps into one (fresh process each).
 		const std::vector<FleetCase> fleets = runFleets(fs::canonical("/proc/self/exe"), quick);
-		const LiveLatency live = runLiveLatency(scansOf, quick ? 3 : 8);
+		const LiveLatency live = runLiveLatency(scansOf, quick ? 4 : 16);
 
 		// 5. Basin of convergence of TsICP alone.
 		const std::vector<double> dyaws = quick ? std::vector<double>{-8, 0, 8}
@@ -1480,13 +1486,12 @@ int main(int argc, char** argv)
 				target("fleet of 8 maps of 1000×1000 cells in ≤ 3 s on 2 cores", num(c.seconds, 1) + " s", c.seconds <= 3);
 		}
 		{
-			int lag = 0;  // the worst, in estimations
-			for (const auto& r : live.robots)
-				if (!r.other_building && r.offline_step >= 0) lag = std::max(lag, r.live_step < 0 ? 99 : r.live_step - r.offline_step);
-			target("live node: merged map and TF within two estimation periods of the maps overlapping (placed ≤ 1 "
-				   "estimation after they can be merged, estimation + fusion within a period, never wrong)",
-				   "lag " + std::to_string(lag) + " estimation(s), " + num(live.max_estimate_s + live.max_merged_s, 2) +
-					   " s of " + num(live.period_s, 1) + " s",
+			const double worst = live.maxLatencySeconds();
+			target("live node: merged map and TF within two estimation periods of the maps overlapping (simulated "
+				   "clock, estimations as slow as measured; never wrong, the other building kept out)",
+				   (worst < 0 ? std::string("a robot never published") : "latency max " + num(worst, 1) + " s") + " of " +
+					   num(2 * live.period_s, 1) + " s; estimations median " + num(live.medianEstimateSeconds(), 2) +
+					   " s, max " + num(live.maxEstimateSeconds(), 2) + " s",
 				   live.met());
 		}
 		{

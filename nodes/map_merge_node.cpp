@@ -95,13 +95,17 @@ int main(int argc, char** argv)
 		params.aligner = ros1::alignerParamsFromRos(
 			pnh, {"merging_rate", "discovery_rate", "estimation_rate", "estimation_confidence", "known_init_poses",
 				  "robot_map_topic", "robot_map_updates_topic", "robot_namespace", "merged_map_topic", "world_frame",
-				  "publish_tf", "output_resolution", "config_file", "config_section"});
+				  "publish_tf", "output_resolution", "estimation_budget", "retry_growth", "config_file",
+				  "config_section"});
 		// m-explore's threshold, default 1.0, maps onto our confidence at
 		// half: 1.0 → 0.5, the calibrated default; min_confidence wins if set.
 		if (!pnh.hasParam("min_confidence")) params.aligner.min_confidence = 0.5 * s.estimation_confidence;
 		params.output_resolution = s.output_resolution;
 		params.known_init_poses = s.known_init_poses;
-		fleet = std::make_unique<ros1::LiveFleet>(params);
+		params.estimation_budget_s = ros1::defaultEstimationBudget(s.estimation_rate);
+		pnh.param("estimation_budget", params.estimation_budget_s, params.estimation_budget_s);
+		pnh.param("retry_growth", params.retry_growth, params.retry_growth);
+		fleet = std::make_unique<ros1::LiveFleet>(params);  // throws on a negative budget or growth
 	}
 	catch (const std::exception& e)
 	{

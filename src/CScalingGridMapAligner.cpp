@@ -275,6 +275,18 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const TPreparedMap& ref, const TPreparedMap& other) const
 {
+	return align(ref, other, std::nullopt);
+}
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
+	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& start_metric) const
+{
+	return align(ref, other, start_metric);
+}
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
+	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const
+{
 	mrpt::system::CTicTac total, stage;
 	TReturnInfo info;
 	auto fail = [&](const std::string& why) {
@@ -292,13 +304,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	if (!sameExtraction(fp, ref.feature_params) || !sameExtraction(fp, other.feature_params))
 		return fail("the maps were prepared with other feature options than this aligner's");
 
-	// 1. RANSAC on the features of every pair of pyramid levels.
-	stage.Tic();
 	std::optional<double> expected_scale;
 	if (options.use_resolution_metadata) expected_scale = other.resolution / ref.resolution;
-	auto hyps = featureHypotheses(ref.features, other.features, fp, expected_scale, options.metadata_scale_tolerance);
-	info.stage_seconds["ransac"] = stage.Tac();
-	info.hypotheses = hyps.size();
 
 	// 2. Edge points (prepared).
 	const PointList &ref_edges = ref.edges, &other_edges = other.edges;
@@ -384,7 +391,25 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 			if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
 		}
 	};
-	refineAll(hyps);
+	// A given start first (tracking): confident, it needs no search.
+	if (start_metric)
+	{
+		Hypothesis h;
+		h.other_to_ref = ref.cell_to_metric.inverse().compose(*start_metric).compose(other.cell_to_metric);
+		info.hypotheses = 1;
+		refineAll({h});
+	}
+	// 1. RANSAC on the features of every pair of pyramid levels.
+	const bool tracked = have && info.confidence >= options.min_confidence;
+	if (!tracked)
+	{
+		stage.Tic();
+		const auto hyps =
+			featureHypotheses(ref.features, other.features, fp, expected_scale, options.metadata_scale_tolerance);
+		info.stage_seconds["ransac"] = stage.Tac();
+		info.hypotheses += hyps.size();
+		refineAll(hyps);
+	}
 	// Where no feature hypothesis convinces, the building's structure may
 	// (StructureHypotheses.h): independent maps whose corners differ.
 	if (options.structure_search && (!have || info.confidence < options.min_confidence))

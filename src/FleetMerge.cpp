@@ -53,11 +53,19 @@ void onThreads(size_t count, const CScalingGridMapAligner& aligner, unsigned thr
 
 using PreparedMaps = std::vector<CScalingGridMapAligner::PreparedMapPtr>;
 
-/** Each map prepared once (most of a pair's time), in parallel. */
-PreparedMaps prepareAll(const std::vector<GridInFrame>& maps, const CScalingGridMapAligner& aligner, unsigned threads)
+/** Each map prepared once (most of a pair's time), in parallel; those the
+ * caller prepared before are taken as they are. */
+PreparedMaps prepareAll(
+	const std::vector<GridInFrame>& maps, const PreparedMaps& given, const CScalingGridMapAligner& aligner,
+	unsigned threads)
 {
 	PreparedMaps out(maps.size());
-	onThreads(maps.size(), aligner, threads, [&](size_t k, const CScalingGridMapAligner& local) {
+	std::vector<size_t> todo;
+	for (size_t k = 0; k < maps.size(); ++k)
+		if (k < given.size() && given[k]) out[k] = given[k];
+		else todo.push_back(k);
+	onThreads(todo.size(), aligner, threads, [&](size_t i, const CScalingGridMapAligner& local) {
+		const size_t k = todo[i];
 		try
 		{
 			out[k] = local.prepare(maps[k].grid);
@@ -72,18 +80,41 @@ PreparedMaps prepareAll(const std::vector<GridInFrame>& maps, const CScalingGrid
 	return out;
 }
 
-/** Aligns each pair (to, from) of prepared maps in parallel. */
-std::vector<FleetEdge> alignPairs(
-	const std::vector<GridInFrame>& maps, const PreparedMaps& prepared, const PairList& pairs,
-	const CScalingGridMapAligner& aligner, unsigned threads)
+/** The edge as `from` placed in `to` (an edge holds one direction). */
+FleetEdge orientedAs(FleetEdge e, size_t to, size_t from)
 {
-	std::vector<FleetEdge> out(pairs.size());
+	if (e.to == from && e.from == to) std::swap(e.to, e.from), e.from_to_to = e.from_to_to.inverse();
+	return e;
+}
+
+struct PairToAlign
+{
+	size_t to = 0, from = 0;
+	std::optional<Similarity2D> start;  //!< from → to between map frames, refined first
+	std::optional<FleetEdge> stand_in;  //!< the earlier result, if the deadline leaves it unaligned
+	size_t age = size_t(-1);  //!< of the earlier result (none: the oldest)
+};
+
+/** Aligns each pair of prepared maps in parallel; a pair not started by the
+ * deadline is left empty. */
+std::vector<std::optional<FleetEdge>> alignPairs(
+	const std::vector<GridInFrame>& maps, const PreparedMaps& prepared, const std::vector<PairToAlign>& pairs,
+	const CScalingGridMapAligner& aligner, unsigned threads,
+	const std::optional<std::chrono::steady_clock::time_point>& deadline, std::atomic<size_t>& started)
+{
+	std::vector<std::optional<FleetEdge>> out(pairs.size());
 	onThreads(pairs.size(), aligner, threads, [&](size_t k, const CScalingGridMapAligner& local) {
-		FleetEdge& e = out[k];
-		e.to = pairs[k].first, e.from = pairs[k].second;
+		if (deadline && std::chrono::steady_clock::now() > *deadline && started > 0) return;
+		++started;
+		FleetEdge& e = out[k].emplace();
+		e.to = pairs[k].to, e.from = pairs[k].from;
 		try
 		{
-			const auto r = local.alignScaled(*prepared[e.to], *prepared[e.from]);
+			const auto& ref = *prepared[e.to];
+			const auto& other = *prepared[e.from];
+			const auto r = pairs[k].start
+				? local.alignScaled(ref, other, betweenGrids(maps[e.to], *pairs[k].start, maps[e.from]))
+				: local.alignScaled(ref, other);
 			e.merged = r.success;
 			e.from_to_to = betweenMapFrames(maps[e.to], r.metric, maps[e.from]);
 			e.confidence = r.success ? r.confidence : 0.0;
@@ -221,13 +252,13 @@ FleetResult placeFromPairs(
 
 FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
-	const FleetParams& params)
+	const FleetParams& params, const FleetHints& hints)
 {
 	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();
 	std::vector<FleetEdge> edges;
-	std::map<std::pair<size_t, size_t>, bool> aligned;  // unordered pair → done
+	std::map<std::pair<size_t, size_t>, bool> done;  // unordered pair → aligned, reused or deferred
 	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
 
 	// Round 1: everything against the reference (the two-map case exactly).
@@ -235,13 +266,45 @@ FleetResult placeFleet(
 	for (size_t k = 0; k < n; ++k)
 		if (k != reference) todo.emplace_back(reference, k);
 	FleetResult out;
-	size_t pairs_aligned = 0;
-	const PreparedMaps prepared = prepareAll(maps, aligner, params.threads);
+	size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0;
+	const PreparedMaps prepared = prepareAll(maps, hints.prepared, aligner, params.threads);
+	std::atomic<size_t> started{0};  // alignments started in this call
 	while (!todo.empty())
 	{
-		for (auto& e : alignPairs(maps, prepared, todo, aligner, params.threads)) edges.push_back(std::move(e));
-		for (const auto& [a, b] : todo) aligned[key(a, b)] = true;
-		pairs_aligned += todo.size();
+		// What still holds from before is taken; the rest is aligned, from its
+		// earlier transform first where it had one.
+		std::vector<PairToAlign> to_align;
+		for (const auto& [to, from] : todo)
+		{
+			done[key(to, from)] = true;
+			std::optional<FleetHints::Known> known;
+			if (hints.known) known = hints.known(to, from);
+			if (known && known->holds)
+			{
+				FleetEdge e = orientedAs(known->edge, to, from);
+				e.reused = true;
+				edges.push_back(std::move(e));
+				++pairs_reused;
+				continue;
+			}
+			PairToAlign p{to, from, std::nullopt, std::nullopt, size_t(-1)};
+			if (known)
+			{
+				p.stand_in = orientedAs(known->edge, to, from);
+				p.stand_in->reused = true;
+				if (p.stand_in->merged) p.start = p.stand_in->from_to_to;
+				p.age = known->age;
+			}
+			to_align.push_back(p);
+		}
+		std::stable_sort(to_align.begin(), to_align.end(), [](const PairToAlign& a, const PairToAlign& b) { return a.age > b.age; });
+		const auto aligned = alignPairs(maps, prepared, to_align, aligner, params.threads, hints.deadline, started);
+		for (size_t k = 0; k < aligned.size(); ++k)
+		{
+			if (aligned[k]) edges.push_back(*aligned[k]), ++pairs_aligned;
+			else if (to_align[k].stand_in) edges.push_back(*to_align[k].stand_in), ++pairs_deferred;
+			else ++pairs_deferred;
+		}
 		out = placeFromPairs(maps, reference, edges, params);
 		edges = out.edges;  // with the dropped marks
 		// Next round: the pairs that can still matter, those with a map that is
@@ -252,13 +315,16 @@ FleetResult placeFleet(
 		for (size_t a = 0; a < n; ++a)
 			for (size_t b = a + 1; b < n; ++b)
 			{
-				if (aligned.count(key(a, b)) || (settled(a) && settled(b))) continue;
+				if (done.count(key(a, b)) || (settled(a) && settled(b))) continue;
 				const bool b_first = out.maps[b].placed && !out.maps[a].placed;
 				todo.emplace_back(b_first ? b : a, b_first ? a : b);
 			}
 	}
 	out.pairs_aligned = pairs_aligned;
-	out.pairs_skipped = n * (n - 1) / 2 - pairs_aligned;
+	out.pairs_reused = pairs_reused;
+	out.pairs_deferred = pairs_deferred;
+	out.pairs_skipped = n * (n - 1) / 2 - done.size();
+	out.prepared = prepared;
 	return out;
 }
 

@@ -143,6 +143,33 @@ TEST(PreparedMaps, AlignAsTheGridsDoAndRefuseOtherFeatureOptions)
 	EXPECT_EQ(t.message.rfind("other map is too small", 0), 0u) << t.message;
 }
 
+// A live fleet tracks a placed pair as its maps grow: refined from the last
+// transform, no search. A start that is wrong (a quarter turn off) must not
+// be trusted: the search runs and finds the right transform anyway.
+TEST(PreparedMaps, AStartIsTrackedWhenConfidentAndSearchedPastWhenWrong)
+{
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 30, 0.6});
+	CScalingGridMapAligner aligner;
+	const auto ref = aligner.prepare(pair.ref), other = aligner.prepare(pair.other);
+	const auto searched = aligner.alignScaled(*ref, *other);
+	ASSERT_TRUE(searched.success) << searched.message;
+
+	const Similarity2D nudged(searched.metric.scale * 1.01, searched.metric.yaw + 0.02,
+							  searched.metric.t + Eigen::Vector2d(0.15, -0.1));
+	const auto tracked = aligner.alignScaled(*ref, *other, nudged);
+	ASSERT_TRUE(tracked.success) << tracked.message;
+	expectAccurate(pair, tracked);
+	EXPECT_EQ(tracked.hypotheses_refined, 1u);
+	EXPECT_EQ(tracked.stage_seconds.count("ransac"), 0u);  // no search
+
+	const Similarity2D wrong(searched.metric.scale, searched.metric.yaw + M_PI / 2, searched.metric.t);
+	const auto recovered = aligner.alignScaled(*ref, *other, wrong);
+	ASSERT_TRUE(recovered.success) << recovered.message;
+	expectAccurate(pair, recovered);
+	EXPECT_GT(recovered.hypotheses_refined, 1u);
+	EXPECT_EQ(recovered.stage_seconds.count("ransac"), 1u);
+}
+
 TEST(MetadataFree, WrongStatedResolutionIsRecovered)
 {
 	// The other map is really 8 cm but claims 5 cm: the implied resolution

@@ -215,3 +215,78 @@ TEST(LiveFleet, AFirstRobotThatOverlapsNoOneDoesNotHoldTheWorld)
 	fleet.estimate();
 	EXPECT_EQ(fleet.worldRobot(), "/robot1");
 }
+
+TEST(LiveFleet, AnEstimationAlignsOnlyWhatChanged)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	ros1::LiveFleetParams p;
+	p.retry_growth = 10;  // a refused pair waits for its maps to grow elevenfold (or retry_estimations)
+	ros1::LiveFleet fleet(p);
+	const auto& R = robots();
+	for (size_t i : {0, 1, 3}) fleet.addRobot(R[i].name);
+	for (size_t i : {0, 1, 3}) ASSERT_EQ(fleet.onMap(R[i].name, mapMsg(R[i], 0.5, 1)), "");
+	fleet.estimate();
+	auto st = fleet.lastEstimation();
+	EXPECT_EQ(st.maps_prepared, 3u);
+	EXPECT_EQ(st.pairs_aligned, 3u);  // robot 4 is placed by nothing: all its pairs are tried
+	const auto placed = statusOf(fleet, "/robot2");
+	ASSERT_TRUE(placed.placed) << placed.message;
+
+	// Nothing changed: nothing is prepared or aligned again, nothing moves.
+	fleet.estimate();
+	st = fleet.lastEstimation();
+	EXPECT_EQ(st.maps_prepared, 0u);
+	EXPECT_EQ(st.pairs_aligned, 0u);
+	EXPECT_EQ(st.pairs_reused, 3u);
+	EXPECT_EQ(statusOf(fleet, "/robot2").in_world.t, placed.in_world.t);
+	EXPECT_FALSE(statusOf(fleet, "/robot4").placed);
+
+	// Robot 2's map grows: it is prepared again and tracked from its placement;
+	// its refused pair with robot 4 waits (it did not grow enough), robot 1's
+	// with robot 4 is unchanged.
+	const auto grown = mapMsg(R[1], 0.6, 2);
+	ASSERT_EQ(fleet.onMap(R[1].name, grown), "");
+	fleet.estimate();
+	st = fleet.lastEstimation();
+	EXPECT_EQ(st.maps_prepared, 1u);
+	EXPECT_EQ(st.pairs_aligned, 1u);
+	EXPECT_EQ(st.pairs_reused, 2u);
+	const auto tracked = statusOf(fleet, "/robot2");
+	ASSERT_TRUE(tracked.placed) << tracked.message;
+	EXPECT_LE(errorCells(grown, R[1], tracked.in_world), 2.0);
+	EXPECT_NE(tracked.message.find("refined"), std::string::npos) << tracked.message;
+}
+
+TEST(LiveFleet, ABudgetDefersPairsButEveryPairIsAlignedInTurn)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	ros1::LiveFleetParams p;
+	p.estimation_budget_s = 1e-6;  // past at once: one alignment per estimation
+	ros1::LiveFleet fleet(p);
+	const auto& R = robots();
+	for (size_t i : {0, 1, 2}) fleet.addRobot(R[i].name);
+	for (size_t i : {0, 1, 2}) ASSERT_EQ(fleet.onMap(R[i].name, mapMsg(R[i], 0.5, 1)), "");
+	size_t aligned = 0, deferred = 0;
+	for (int k = 0; k < 3; ++k)
+	{
+		fleet.estimate();
+		const auto st = fleet.lastEstimation();
+		EXPECT_GE(st.pairs_aligned, 1u);  // always progress
+		EXPECT_LE(st.pairs_aligned, 2u);  // at most one per thread
+		aligned += st.pairs_aligned, deferred += st.pairs_deferred;
+		if (st.pairs_deferred == 0) break;  // every pair known: the next estimation has nothing to do
+	}
+	EXPECT_GT(deferred, 0u);
+	EXPECT_GE(aligned, 2u);  // both robots' pairs in turn, none starved
+	fleet.estimate();  // all known now: nothing left to align
+	const auto st = fleet.lastEstimation();
+	EXPECT_EQ(st.pairs_aligned, 0u);
+	EXPECT_EQ(st.pairs_deferred, 0u);
+	EXPECT_EQ(st.pairs_reused + st.pairs_skipped, 3u);  // skipped: between maps placed surely
+	for (size_t i : {1, 2})
+	{
+		const auto s = statusOf(fleet, R[i].name);
+		ASSERT_TRUE(s.placed) << R[i].name << ": " << s.message;
+		EXPECT_LE(errorCells(mapMsg(R[i], 0.5, 1), R[i], s.in_world), 2.0) << R[i].name;
+	}
+}

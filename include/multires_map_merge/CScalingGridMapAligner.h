@@ -22,6 +22,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace multires_map_merge
@@ -179,6 +180,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	 * pair's stages only; executionTime excludes the preparation). */
 	TReturnInfo alignScaled(const TPreparedMap& ref, const TPreparedMap& other) const;
 
+	/** The same, refining `start_metric` (other's grid metric frame → ref's,
+	 * e.g. the pair's last result before the maps grew) first: when that is
+	 * confident, the global search (features, structure) is skipped. How a
+	 * live fleet tracks a pair cheaply; an unconfident start costs one
+	 * refinement more than alignScaled. */
+	TReturnInfo alignScaled(
+		const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& start_metric) const;
+
 	/** The same for maps held in their exact frames (map_server files, ROS
 	 * messages; MapIO, OccupancyGridConversion): TReturnInfo::metric is then
 	 * between the *maps'* frames (x_ref_map = metric(x_other_map)), exact for
@@ -199,6 +208,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		const mrpt::maps::CMetricMap* m1, const mrpt::maps::CMetricMap* m2,
 		const mrpt::poses::CPose3DPDFGaussian& initialEstimationPDF,
 		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
+
+   private:
+	TReturnInfo align(
+		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
 };
 
 }  // namespace multires_map_merge

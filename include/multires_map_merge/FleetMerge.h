@@ -10,6 +10,9 @@
 #include <multires_map_merge/GridInFrame.h>
 
 #include <opencv2/core.hpp>
+#include <chrono>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +27,7 @@ struct FleetEdge
 	double confidence = 0;
 	std::string message;  //!< the aligner's
 	bool dropped = false;  //!< contradicted the others around a cycle
+	bool reused = false;  //!< an earlier result (FleetHints::known), not aligned in this call
 };
 
 struct FleetPlacement
@@ -49,11 +53,43 @@ struct FleetParams
 	double cycle_tolerance_cells = 3.0;
 };
 
+/** What a caller that places the same fleet again and again (LiveFleet, as
+ * the maps grow) knows from before, so that a call costs what changed. */
+struct FleetHints
+{
+	/** Maps already prepared with the aligner's options, per input (missing
+	 * or null: prepared in this call). */
+	std::vector<CScalingGridMapAligner::PreparedMapPtr> prepared;
+	struct Known
+	{
+		FleetEdge edge;  //!< an earlier result for the pair (either direction)
+		/** Still holds (say, neither map changed enough since): taken as is.
+		 * Otherwise the pair is aligned again, from `edge`'s transform first
+		 * if it was merged (tracking), and `edge` stands in if the deadline
+		 * leaves no time to align it. */
+		bool holds = false;
+		/** How stale it is (say, estimations since): of the pairs to align,
+		 * those never aligned go first, then the stalest, so that a deadline
+		 * starves none. */
+		size_t age = 0;
+	};
+	/** The earlier result for the pair of maps (a, b), if any. */
+	std::function<std::optional<Known>(size_t a, size_t b)> known;
+	/** No alignment starts after this (those started finish; one always
+	 * starts, so that repeated calls progress): the pairs left are counted in
+	 * pairs_deferred. */
+	std::optional<std::chrono::steady_clock::time_point> deadline;
+};
+
 struct FleetResult
 {
 	std::vector<FleetPlacement> maps;  //!< one per input, in input order
-	std::vector<FleetEdge> edges;  //!< every aligned pair
+	std::vector<FleetEdge> edges;  //!< every pair aligned or reused
 	size_t pairs_aligned = 0, pairs_skipped = 0;
+	size_t pairs_reused = 0;  //!< FleetHints::known results that hold, taken as they are
+	size_t pairs_deferred = 0;  //!< not aligned, the deadline passed (an earlier result, if any, stands in)
+	/** Each input as prepared (what FleetHints::prepared takes next time). */
+	std::vector<CScalingGridMapAligner::PreparedMapPtr> prepared;
 	bool allPlaced() const;
 };
 
@@ -75,7 +111,7 @@ FleetResult placeFromPairs(
  * on fewer than two maps or a reference out of range. */
 FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
-	const FleetParams& params = {});
+	const FleetParams& params = {}, const FleetHints& hints = {});
 
 struct FusedFleet
 {

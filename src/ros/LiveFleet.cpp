@@ -3,6 +3,7 @@
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <algorithm>
+#include <chrono>
 #include <functional>
 #include <numeric>
 #include <cmath>
@@ -18,6 +19,10 @@ LiveFleet::LiveFleet(const LiveFleetParams& params) : params_(params)
 	if (!(params_.output_resolution >= 0) || !std::isfinite(params_.output_resolution))
 		throw std::invalid_argument("output_resolution must be 0 (the world robot's) or metres > 0");
 	if (!(params_.agreement_cells > 0)) throw std::invalid_argument("agreement_cells must be > 0");
+	if (!(params_.retry_growth >= 0) || !std::isfinite(params_.retry_growth))
+		throw std::invalid_argument("retry_growth must be a share >= 0");
+	if (!(params_.estimation_budget_s >= 0) || !std::isfinite(params_.estimation_budget_s))
+		throw std::invalid_argument("estimation_budget_s must be seconds >= 0 (0: no limit)");
 }
 
 LiveFleet::Robot* LiveFleet::find(const std::string& name)
@@ -65,6 +70,7 @@ std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::Occupancy
 	if (r->map && r->map->header.stamp > msg.header.stamp)
 		return "ignored: older than the map held for " + robot;
 	r->map = msg;
+	++r->map_version;
 	++version_;
 	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
 	return "";
@@ -95,6 +101,7 @@ std::string LiveFleet::onUpdate(const std::string& robot, const map_msgs::Occupa
 		std::copy_n(msg.data.begin() + size_t(y) * msg.width, w,
 					map.data.begin() + size_t(msg.y + y) * map.info.width + msg.x);
 	if (msg.header.stamp > map.header.stamp) map.header.stamp = msg.header.stamp;
+	++r->map_version;
 	++version_;
 	return "";
 }
@@ -133,12 +140,14 @@ int largestGroupMember(size_t n, const std::vector<FleetEdge>& edges)
 void LiveFleet::estimate()
 {
 	// Snapshot under the lock; align without it (maps keep arriving).
+	const auto started = std::chrono::steady_clock::now();
 	std::vector<std::string> names;
 	std::vector<GridInFrame> maps;
-	size_t world = 0;
+	std::vector<size_t> robot_of, versions, known_cells;  // per map in the snapshot
+	size_t world = 0, estimation = 0;
 	{
 		std::lock_guard<std::mutex> lock(mutex_);
-		++estimations_;
+		estimation = ++estimations_;
 		if (params_.known_init_poses)
 		{
 			++version_;
@@ -151,24 +160,77 @@ void LiveFleet::estimate()
 			return;
 		}
 		if (world_robot_.empty()) return;
-		for (const auto& r : robots_)
-			if (r.map)
+		for (size_t i = 0; i < robots_.size(); ++i)
+			if (const Robot& r = robots_[i]; r.map)
 			{
 				if (r.name == world_robot_) world = names.size();
 				names.push_back(r.name);
 				maps.push_back(gridFromMsg(*r.map, r.name));  // validated on arrival
+				robot_of.push_back(i);
+				versions.push_back(r.map_version);
+				known_cells.push_back(size_t(std::count_if(r.map->data.begin(), r.map->data.end(), [](int8_t v) { return v >= 0; })));
 			}
 	}
+	// What the last estimations found and still holds (LiveFleetParams).
+	FleetHints hints;
+	for (size_t m = 0; m < maps.size(); ++m)
+	{
+		const auto it = prepared_memory_.find(robot_of[m]);
+		hints.prepared.push_back(it != prepared_memory_.end() && it->second.map_version == versions[m] ? it->second.prepared : nullptr);
+	}
+	auto index_of = [&](size_t robot) {
+		return size_t(std::find(robot_of.begin(), robot_of.end(), robot) - robot_of.begin());
+	};
+	hints.known = [&](size_t a, size_t b) -> std::optional<FleetHints::Known> {
+		const auto it = pair_memory_.find(std::minmax(robot_of[a], robot_of[b]));
+		if (it == pair_memory_.end()) return std::nullopt;
+		const PairMemory& mem = it->second;
+		FleetHints::Known k;
+		k.edge = mem.edge;
+		k.edge.to = index_of(mem.edge.to), k.edge.from = index_of(mem.edge.from);
+		const size_t to = k.edge.to, from = k.edge.from;
+		const bool unchanged = versions[to] == mem.to_version && versions[from] == mem.from_version;
+		auto grew = [&](size_t now, size_t then) { return double(now) > (1 + params_.retry_growth) * double(then); };
+		const bool worth_retrying = grew(known_cells[to], mem.to_known) || grew(known_cells[from], mem.from_known) ||
+			estimation >= mem.estimation + params_.retry_estimations;
+		k.holds = unchanged || (!mem.edge.merged && !worth_retrying);
+		k.age = estimation - mem.estimation;
+		return k;
+	};
+	if (params_.estimation_budget_s > 0)
+		hints.deadline = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+									   std::chrono::duration<double>(params_.estimation_budget_s));
 	std::optional<FleetResult> result;
 	std::string failure;
 	bool world_moved = false;
+	EstimationStats stats;
+	stats.maps = maps.size();
+	stats.maps_prepared = size_t(std::count(hints.prepared.begin(), hints.prepared.end(), nullptr));
 	if (maps.size() >= 2)
 	{
 		try
 		{
 			CScalingGridMapAligner aligner;
 			aligner.options = params_.aligner;
-			result = placeFleet(maps, world, aligner);
+			result = placeFleet(maps, world, aligner, {}, hints);
+			stats.pairs_aligned = result->pairs_aligned, stats.pairs_reused = result->pairs_reused;
+			stats.pairs_deferred = result->pairs_deferred, stats.pairs_skipped = result->pairs_skipped;
+			for (size_t m = 0; m < maps.size(); ++m) prepared_memory_[robot_of[m]] = {versions[m], result->prepared[m]};
+			for (const FleetEdge& e : result->edges)
+			{
+				// Fresh alignments only; one dropped around a cycle is suspect:
+				// aligned again next time.
+				if (e.reused || e.dropped) continue;
+				PairMemory mem;
+				mem.edge = e;
+				mem.edge.to = robot_of[e.to], mem.edge.from = robot_of[e.from];
+				mem.to_version = versions[e.to], mem.from_version = versions[e.from];
+				mem.to_known = known_cells[e.to], mem.from_known = known_cells[e.from];
+				mem.estimation = estimation;
+				pair_memory_[std::minmax(mem.edge.to, mem.edge.from)] = mem;
+			}
+			for (FleetEdge& e : result->edges)
+				if (e.dropped) pair_memory_.erase(std::minmax(robot_of[e.to], robot_of[e.from]));
 			// The world is provisional until a second robot is placed in it: if
 			// its robot overlaps no one (another building, a robot far away)
 			// while others overlap each other, the world moves to the largest
@@ -190,7 +252,9 @@ void LiveFleet::estimate()
 			failure = e.what();
 		}
 	}
+	stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 	std::lock_guard<std::mutex> lock(mutex_);
+	last_estimation_ = stats;
 	++version_;  // placements may have changed
 	if (world_moved)
 	{
@@ -320,6 +384,12 @@ size_t LiveFleet::estimations() const
 {
 	std::lock_guard<std::mutex> lock(mutex_);
 	return estimations_;
+}
+
+LiveFleet::EstimationStats LiveFleet::lastEstimation() const
+{
+	std::lock_guard<std::mutex> lock(mutex_);
+	return last_estimation_;
 }
 
 }  // namespace multires_map_merge::ros1

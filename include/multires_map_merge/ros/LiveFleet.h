@@ -37,7 +37,27 @@ struct LiveFleetParams
 	 * corners) of the kept placement agrees with it. */
 	double agreement_cells = 3.0;
 	size_t max_merged_cells = size_t(1) << 26;
+	/** An estimation aligns again only what changed: a map is prepared again
+	 * when it changed; a pair when a map of it changed, from its last
+	 * transform first if it was merged (tracking: one refinement instead of
+	 * a search). A refused pair is tried again once one of its maps has this
+	 * much more known cells than at the refusal... */
+	double retry_growth = 0.1;
+	/** ...or this many estimations after it, if a map of it changed at all. */
+	size_t retry_estimations = 10;
+	/** No pair alignment starts after this many seconds of an estimation
+	 * (0: no limit); the pairs left wait for the next one, their earlier
+	 * results standing in. Keeps an estimation near its period. */
+	double estimation_budget_s = 0;
 };
+
+/** The estimation budget the node sets at an estimation rate (Hz): half the
+ * period, so that with the pairs already started an estimation stays near
+ * its period. */
+inline double defaultEstimationBudget(double estimation_rate_hz)
+{
+	return estimation_rate_hz > 0 ? 0.5 / estimation_rate_hz : 0.0;
+}
 
 class LiveFleet
 {
@@ -78,6 +98,14 @@ class LiveFleet
 	std::string worldRobot() const;
 	/** Estimations run so far. */
 	size_t estimations() const;
+	/** What the last estimation did. */
+	struct EstimationStats
+	{
+		size_t maps = 0, maps_prepared = 0;  //!< maps_prepared: changed since they were last prepared
+		size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0, pairs_skipped = 0;
+		double seconds = 0;
+	};
+	EstimationStats lastEstimation() const;
 
    private:
 	struct Robot
@@ -90,6 +118,20 @@ class LiveFleet
 		double confidence = 0;
 		std::optional<Similarity2D> pending;  //!< a disagreeing estimate awaiting confirmation
 		std::string message;
+		size_t map_version = 0;  //!< bumped by every map or update taken
+	};
+	/** A pair's last alignment and the maps it came from (estimate() only). */
+	struct PairMemory
+	{
+		FleetEdge edge;  //!< `to` and `from` as robot indices into robots_
+		size_t to_version = 0, from_version = 0;
+		size_t to_known = 0, from_known = 0;  //!< known cells of each map then
+		size_t estimation = 0;  //!< when
+	};
+	struct PreparedMemory
+	{
+		size_t map_version = 0;
+		CScalingGridMapAligner::PreparedMapPtr prepared;
 	};
 	Robot* find(const std::string& name);
 	const Robot* find(const std::string& name) const;
@@ -107,6 +149,11 @@ class LiveFleet
 	std::string merged_why_, merged_frame_;
 	std::string world_robot_;
 	size_t estimations_ = 0;
+	EstimationStats last_estimation_;
+	/** Only estimate() reads or writes these (one thread, by contract). Keyed
+	 * by robot index into robots_ (robots are never removed). */
+	std::map<std::pair<size_t, size_t>, PairMemory> pair_memory_;  // (lower, higher index)
+	std::map<size_t, PreparedMemory> prepared_memory_;
 };
 
 }  // namespace multires_map_merge::ros1
