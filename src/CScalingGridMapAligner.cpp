@@ -7,6 +7,9 @@
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/system/CTicTac.h>
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
 
 #include <cmath>
 #include <sstream>
@@ -321,74 +324,104 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	const TsICPParams ip = options.icpParams();
 	double icp_s = 0, verify_s = 0;
 	bool have = false;
-	auto refineAll = [&](const std::vector<Hypothesis>& list) {
-		int budget = options.max_hypotheses;
-		for (const auto& h : list)
-		{
-			if (budget-- <= 0) break;
-			++info.hypotheses_refined;
-			stage.Tic();
-			const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
-			icp_s += stage.Tac();
-			if (!r.transform.isFinite() || !(r.transform.scale > 0)) continue;
-			if (expected_scale &&
-				std::abs(std::log(r.transform.scale / *expected_scale)) >
-					std::log1p(options.metadata_scale_tolerance))
-				continue;
+	// One hypothesis refined and judged: no shared state, so a few run at once.
+	struct Refined
+	{
+		bool valid = false;
+		TsICPResult r;
+		TCandidate cand;
+		double icp_s = 0, verify_s = 0;
+	};
+	auto refineOne = [&](const Hypothesis& h) {
+		Refined out;
+		mrpt::system::CTicTac clock;
+		const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
+		out.icp_s = clock.Tac();
+		if (!r.transform.isFinite() || !(r.transform.scale > 0)) return out;
+		if (expected_scale &&
+			std::abs(std::log(r.transform.scale / *expected_scale)) > std::log1p(options.metadata_scale_tolerance))
+			return out;
 
-			// 4. Judge on the cells, against chance (MapAgreement.h).
-			stage.Tic();
-			const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
-			const TwoWaySupport sup = twoWaySupport(
-				ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
-			const Chance chance = chanceSupport(
-				ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
-				options.verify_shift, options.verify_turn_deg);
-			verify_s += stage.Tac();
-			const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
-			const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
-			TCandidate cand;
-			cand.initial_cells = h.other_to_ref;
-			cand.cells = r.transform;
-			cand.overlap = r.overlap;
-			cand.rmse_coarse_cells = rmse_coarse;
-			cand.consistency = ag.consistency;
-			cand.tolerant_consistency = sup.consistency();
-			cand.chance_consistency = chance.consistency;
-			cand.support = sup.score();
-			cand.judged_points = sup.judged();
-			cand.score = cand.tolerant_consistency +
-				options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
-				std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
-			// Two ways to be sure: the maps coincide cell for cell, or (independent
-			// maps) their walls agree within the tolerance well above chance.
-			const double tolerant_conf = cand.judged_points < kMinJudgedPoints
-				? 0.0
-				: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
-			const double conf = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
-			cand.confidence = conf;
-			info.candidates.push_back(cand);
-			MRPT_LOG_DEBUG_STREAM(
-				"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
-							  << r.overlap << " rmse " << rmse_coarse << " tolerant consistency "
-							  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
-							  << cand.score << " conf " << conf);
-			if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
-				continue;
-			have = true;
-			info.cells = r.transform;
-			info.initial_cells = h.other_to_ref;
-			info.overlap = r.overlap;
-			info.objective = r.objective;
-			info.trimmed_rmse_coarse_cells = rmse_coarse;
-			info.consistency = cand.tolerant_consistency;
-			info.chance_consistency = cand.chance_consistency;
-			info.confidence = conf;
-			info.ransac_inliers = h.inliers;
-			info.ransac_matches = h.matches;
-			info.icp_iterations = r.iterations;
-			info.objective_history = r.objective_history;
-			if (conf >= 0.95) break;  // no other hypothesis can do meaningfully better
+		// 4. Judge on the cells, against chance (MapAgreement.h).
+		clock.Tic();
+		const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
+		const TwoWaySupport sup =
+			twoWaySupport(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
+		const Chance chance = chanceSupport(
+			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
+			options.verify_shift, options.verify_turn_deg);
+		out.verify_s = clock.Tac();
+		const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
+		const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
+		TCandidate& cand = out.cand;
+		cand.initial_cells = h.other_to_ref;
+		cand.cells = r.transform;
+		cand.overlap = r.overlap;
+		cand.rmse_coarse_cells = rmse_coarse;
+		cand.consistency = ag.consistency;
+		cand.tolerant_consistency = sup.consistency();
+		cand.chance_consistency = chance.consistency;
+		cand.support = sup.score();
+		cand.judged_points = sup.judged();
+		cand.score = cand.tolerant_consistency +
+			options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
+			std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
+		// Two ways to be sure: the maps coincide cell for cell, or (independent
+		// maps) their walls agree within the tolerance well above chance.
+		const double tolerant_conf = cand.judged_points < kMinJudgedPoints
+			? 0.0
+			: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
+		cand.confidence = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
+		out.r = r;
+		out.valid = true;
+		return out;
+	};
+	// Refined a few at a time (one per thread), judged in order: the result
+	// is the sequential one, at most a batch's tail computed in vain when a
+	// hypothesis is sure enough to stop at.
+	auto refineAll = [&](const std::vector<Hypothesis>& list) {
+		const size_t n = std::min<size_t>(list.size(), size_t(std::max(0, options.max_hypotheses)));
+		const size_t batch = size_t(std::clamp(cv::getNumThreads(), 1, 4));
+		bool stop = false;
+		for (size_t first = 0; first < n && !stop; first += batch)
+		{
+			std::vector<Refined> done(std::min(batch, n - first));
+			cv::parallel_for_(cv::Range(0, int(done.size())), [&](const cv::Range& range) {
+				for (int j = range.start; j < range.end; ++j) done[j] = refineOne(list[first + j]);
+			});
+			for (size_t j = 0; j < done.size() && !stop; ++j)
+			{
+				const Hypothesis& h = list[first + j];
+				const Refined& one = done[j];
+				++info.hypotheses_refined;
+				icp_s += one.icp_s, verify_s += one.verify_s;
+				if (!one.valid) continue;
+				const TsICPResult& r = one.r;
+				const TCandidate& cand = one.cand;
+				const double conf = cand.confidence;
+				info.candidates.push_back(cand);
+				MRPT_LOG_DEBUG_STREAM(
+					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
+								  << r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
+								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
+								  << cand.score << " conf " << conf);
+				if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
+					continue;
+				have = true;
+				info.cells = r.transform;
+				info.initial_cells = h.other_to_ref;
+				info.overlap = r.overlap;
+				info.objective = r.objective;
+				info.trimmed_rmse_coarse_cells = cand.rmse_coarse_cells;
+				info.consistency = cand.tolerant_consistency;
+				info.chance_consistency = cand.chance_consistency;
+				info.confidence = conf;
+				info.ransac_inliers = h.inliers;
+				info.ransac_matches = h.matches;
+				info.icp_iterations = r.iterations;
+				info.objective_history = r.objective_history;
+				if (conf >= 0.95) stop = true;  // no other hypothesis can do meaningfully better
+			}
 		}
 	};
 	// A given start first (tracking): confident, it needs no search.
@@ -400,8 +433,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		refineAll({h});
 	}
 	// 1. RANSAC on the features of every pair of pyramid levels.
-	const bool tracked = have && info.confidence >= options.min_confidence;
-	if (!tracked)
+	info.tracked = have && info.confidence >= options.min_confidence;
+	if (!info.tracked)
 	{
 		stage.Tic();
 		const auto hyps =

@@ -93,6 +93,15 @@ struct PairToAlign
 	std::optional<Similarity2D> start;  //!< from → to between map frames, refined first
 	std::optional<FleetEdge> stand_in;  //!< the earlier result, if the deadline leaves it unaligned
 	size_t age = size_t(-1);  //!< of the earlier result (none: the oldest)
+	/** Order past a deadline: never aligned, then overdue, then tracking a
+	 * placed pair (cheap, and what keeps placements fresh), then the rest;
+	 * the stalest first within each. */
+	int rank(size_t overdue_age) const
+	{
+		if (!stand_in) return 0;
+		if (age >= overdue_age) return 1;
+		return start ? 2 : 3;
+	}
 };
 
 /** Aligns each pair of prepared maps in parallel; a pair not started by the
@@ -100,11 +109,12 @@ struct PairToAlign
 std::vector<std::optional<FleetEdge>> alignPairs(
 	const std::vector<GridInFrame>& maps, const PreparedMaps& prepared, const std::vector<PairToAlign>& pairs,
 	const CScalingGridMapAligner& aligner, unsigned threads,
-	const std::optional<std::chrono::steady_clock::time_point>& deadline, std::atomic<size_t>& started)
+	const std::optional<std::chrono::steady_clock::time_point>& deadline, bool first_must_start)
 {
 	std::vector<std::optional<FleetEdge>> out(pairs.size());
+	std::atomic<size_t> started{0};
 	onThreads(pairs.size(), aligner, threads, [&](size_t k, const CScalingGridMapAligner& local) {
-		if (deadline && std::chrono::steady_clock::now() > *deadline && started > 0) return;
+		if (deadline && std::chrono::steady_clock::now() > *deadline && (started > 0 || !first_must_start)) return;
 		++started;
 		FleetEdge& e = out[k].emplace();
 		e.to = pairs[k].to, e.from = pairs[k].from;
@@ -116,13 +126,14 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 				? local.alignScaled(ref, other, betweenGrids(maps[e.to], *pairs[k].start, maps[e.from]))
 				: local.alignScaled(ref, other);
 			e.merged = r.success;
+			e.tracked = r.tracked;
 			e.from_to_to = betweenMapFrames(maps[e.to], r.metric, maps[e.from]);
 			e.confidence = r.success ? r.confidence : 0.0;
-			e.message = r.message;
+			e.message = e.aligner_message = r.message;
 		}
 		catch (const std::exception& ex)
 		{
-			e.message = ex.what();
+			e.message = e.aligner_message = ex.what();
 		}
 	});
 	return out;
@@ -217,7 +228,8 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 		});
 		edges[weakest].dropped = true;
 		std::ostringstream why;
-		why << "dropped: contradicts the other alignments around a cycle (" << edges[weakest].message << ")";
+		why << "dropped: contradicts the other alignments around a cycle ("
+			<< (edges[weakest].aligner_message.empty() ? edges[weakest].message : edges[weakest].aligner_message) << ")";
 		edges[weakest].message = why.str();
 	}
 }
@@ -268,7 +280,7 @@ FleetResult placeFleet(
 	FleetResult out;
 	size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0;
 	const PreparedMaps prepared = prepareAll(maps, hints.prepared, aligner, params.threads);
-	std::atomic<size_t> started{0};  // alignments started in this call
+	bool first_round = true;
 	while (!todo.empty())
 	{
 		// What still holds from before is taken; the rest is aligned, from its
@@ -292,13 +304,21 @@ FleetResult placeFleet(
 			{
 				p.stand_in = orientedAs(known->edge, to, from);
 				p.stand_in->reused = true;
-				if (p.stand_in->merged) p.start = p.stand_in->from_to_to;
+				if (p.stand_in->merged && known->track) p.start = p.stand_in->from_to_to;
 				p.age = known->age;
 			}
 			to_align.push_back(p);
 		}
-		std::stable_sort(to_align.begin(), to_align.end(), [](const PairToAlign& a, const PairToAlign& b) { return a.age > b.age; });
-		const auto aligned = alignPairs(maps, prepared, to_align, aligner, params.threads, hints.deadline, started);
+		const size_t overdue = hints.overdue_age;
+		std::stable_sort(to_align.begin(), to_align.end(), [overdue](const PairToAlign& a, const PairToAlign& b) {
+			return a.rank(overdue) != b.rank(overdue) ? a.rank(overdue) < b.rank(overdue) : a.age > b.age;
+		});
+		// Past the deadline one pair still starts in the first round (every
+		// call progresses) and in a later one if it was never aligned or is
+		// overdue (none starves); the rest wait.
+		const bool first_must_start = first_round || (!to_align.empty() && to_align.front().rank(overdue) <= 1);
+		first_round = false;
+		const auto aligned = alignPairs(maps, prepared, to_align, aligner, params.threads, hints.deadline, first_must_start);
 		for (size_t k = 0; k < aligned.size(); ++k)
 		{
 			if (aligned[k]) edges.push_back(*aligned[k]), ++pairs_aligned;

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
+#include <opencv2/core/utility.hpp>
 
 namespace multires_map_merge
 {
@@ -92,10 +94,17 @@ std::vector<Hypothesis> structureHypotheses(
 
 	const Similarity2D other_down = resampling(f_other), ref_up = resampling(f_ref).inverse();
 	std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra_of_a;  // a and a², by canvas size
-	std::vector<Scored> found;
-	for (const double s : scales)
-		for (int k = 0; k < 4; ++k)
+	std::mutex spectra_mutex;
+	// The poses (scale × right-angle turn) are independent: searched in
+	// parallel, each keeping its own peaks, gathered in pose order so the
+	// result does not depend on the threads.
+	std::vector<std::vector<Scored>> found_per_pose(scales.size() * 4);
+	cv::parallel_for_(cv::Range(0, int(scales.size() * 4)), [&](const cv::Range& range) {
+		for (int pose = range.start; pose < range.end; ++pose)
 		{
+			const double s = scales[pose / 4];
+			const int k = pose % 4;
+			std::vector<Scored>& found = found_per_pose[pose];
 			// Other's working image → ref's working image, up to a translation.
 			const Similarity2D lin(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0});
 			Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
@@ -129,8 +138,13 @@ std::vector<Hypothesis> structureHypotheses(
 				cv::idft(prod, c, cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
 				return c;
 			};
-			auto& [fa, fa2] = spectra_of_a[{w, h}];
-			if (fa.empty()) fa = spectrum(a), fa2 = spectrum(a.mul(a));
+			cv::Mat fa, fa2;
+			{
+				std::lock_guard<std::mutex> lock(spectra_mutex);
+				auto& cached = spectra_of_a[{w, h}];
+				if (cached.first.empty()) cached = {spectrum(a), spectrum(a.mul(a))};
+				fa = cached.first, fa2 = cached.second;
+			}
 			cv::Mat footprint;
 			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
 			cv::Mat corr = correlate(fa, spectrum(b));
@@ -151,6 +165,9 @@ std::vector<Hypothesis> structureHypotheses(
 				cv::circle(corr, at, 6, cv::Scalar(0), cv::FILLED);
 			}
 		}
+	});
+	std::vector<Scored> found;
+	for (const auto& f : found_per_pose) found.insert(found.end(), f.begin(), f.end());
 	std::sort(found.begin(), found.end(), [](const Scored& x, const Scored& y) { return x.score > y.score; });
 	for (const auto& f : found)
 	{

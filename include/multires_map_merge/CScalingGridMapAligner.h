@@ -119,6 +119,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Every refined hypothesis, in the order refined. */
 		std::vector<TCandidate> candidates;
 		bool success = false;  //!< merged with confidence ≥ min_confidence
+		/** A given start was confident: no global search ran (alignScaled with
+		 * a start). */
+		bool tracked = false;
 		std::string message;  //!< why not, when not
 		/** x_ref = metric(x_other), metres, each map read with its stated metadata. */
 		Similarity2D metric;

@@ -28,6 +28,8 @@ struct FleetEdge
 	std::string message;  //!< the aligner's
 	bool dropped = false;  //!< contradicted the others around a cycle
 	bool reused = false;  //!< an earlier result (FleetHints::known), not aligned in this call
+	bool tracked = false;  //!< refined from the earlier transform only (no global search)
+	std::string aligner_message;  //!< the aligner's, before any note of placing (`message`)
 };
 
 struct FleetPlacement
@@ -68,17 +70,23 @@ struct FleetHints
 		 * if it was merged (tracking), and `edge` stands in if the deadline
 		 * leaves no time to align it. */
 		bool holds = false;
-		/** How stale it is (say, estimations since): of the pairs to align,
-		 * those never aligned go first, then the stalest, so that a deadline
-		 * starves none. */
+		/** How stale it is (say, estimations since): orders the pairs to
+		 * align (see `deadline`). */
 		size_t age = 0;
+		/** Realigned from its transform first (if merged); false: searched
+		 * afresh, as a check independent of the earlier result. */
+		bool track = true;
 	};
 	/** The earlier result for the pair of maps (a, b), if any. */
 	std::function<std::optional<Known>(size_t a, size_t b)> known;
-	/** No alignment starts after this (those started finish; one always
-	 * starts, so that repeated calls progress): the pairs left are counted in
-	 * pairs_deferred. */
+	/** No alignment starts after this (those started finish): the pairs left
+	 * are counted in pairs_deferred. Past it, the first round still starts
+	 * one pair (every call progresses), a later round one if it was never
+	 * aligned or its result is `overdue_age` old (none starves). Pairs go
+	 * never aligned first, then overdue, then placed pairs to track, then the
+	 * rest, the stalest first within each. */
 	std::optional<std::chrono::steady_clock::time_point> deadline;
+	size_t overdue_age = size_t(-1);
 };
 
 struct FleetResult

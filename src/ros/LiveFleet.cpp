@@ -69,7 +69,12 @@ std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::Occupancy
 	if (!r) return "ignored: unknown robot '" + robot + "'";
 	if (r->map && r->map->header.stamp > msg.header.stamp)
 		return "ignored: older than the map held for " + robot;
+	// A map sent again unchanged (SLAM nodes republish) changes nothing to
+	// estimate or fuse.
+	const bool same = r->map && r->map->info == msg.info && r->map->data == msg.data &&
+		r->map->header.frame_id == msg.header.frame_id;
 	r->map = msg;
+	if (same) return "";
 	++r->map_version;
 	++version_;
 	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
@@ -144,6 +149,7 @@ void LiveFleet::estimate()
 	std::vector<std::string> names;
 	std::vector<GridInFrame> maps;
 	std::vector<size_t> robot_of, versions, known_cells;  // per map in the snapshot
+	std::vector<bool> pending;  // a disagreeing estimate awaits confirmation
 	size_t world = 0, estimation = 0;
 	{
 		std::lock_guard<std::mutex> lock(mutex_);
@@ -168,6 +174,7 @@ void LiveFleet::estimate()
 				maps.push_back(gridFromMsg(*r.map, r.name));  // validated on arrival
 				robot_of.push_back(i);
 				versions.push_back(r.map_version);
+				pending.push_back(r.pending.has_value());
 				known_cells.push_back(size_t(std::count_if(r.map->data.begin(), r.map->data.end(), [](int8_t v) { return v >= 0; })));
 			}
 	}
@@ -176,7 +183,9 @@ void LiveFleet::estimate()
 	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		const auto it = prepared_memory_.find(robot_of[m]);
-		hints.prepared.push_back(it != prepared_memory_.end() && it->second.map_version == versions[m] ? it->second.prepared : nullptr);
+		const bool current = it != prepared_memory_.end() && it->second.map_version == versions[m];
+		hints.prepared.push_back(current ? it->second.prepared : nullptr);
+		if (!current && it != prepared_memory_.end()) prepared_memory_.erase(it);  // not two of a map at once
 	}
 	auto index_of = [&](size_t robot) {
 		return size_t(std::find(robot_of.begin(), robot_of.end(), robot) - robot_of.begin());
@@ -195,8 +204,13 @@ void LiveFleet::estimate()
 			estimation >= mem.estimation + params_.retry_estimations;
 		k.holds = unchanged || (!mem.edge.merged && !worth_retrying);
 		k.age = estimation - mem.estimation;
+		// Tracking follows the last result; a fresh search now and then, and
+		// whenever a move awaits confirmation, keeps a wrong placement from
+		// confirming itself.
+		k.track = !pending[to] && !pending[from] && estimation < mem.searched + params_.retry_estimations;
 		return k;
 	};
+	hints.overdue_age = params_.retry_estimations;
 	if (params_.estimation_budget_s > 0)
 		hints.deadline = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
 									   std::chrono::duration<double>(params_.estimation_budget_s));
@@ -205,7 +219,6 @@ void LiveFleet::estimate()
 	bool world_moved = false;
 	EstimationStats stats;
 	stats.maps = maps.size();
-	stats.maps_prepared = size_t(std::count(hints.prepared.begin(), hints.prepared.end(), nullptr));
 	if (maps.size() >= 2)
 	{
 		try
@@ -215,27 +228,32 @@ void LiveFleet::estimate()
 			result = placeFleet(maps, world, aligner, {}, hints);
 			stats.pairs_aligned = result->pairs_aligned, stats.pairs_reused = result->pairs_reused;
 			stats.pairs_deferred = result->pairs_deferred, stats.pairs_skipped = result->pairs_skipped;
-			for (size_t m = 0; m < maps.size(); ++m) prepared_memory_[robot_of[m]] = {versions[m], result->prepared[m]};
+			stats.maps_prepared = size_t(std::count(hints.prepared.begin(), hints.prepared.end(), nullptr));
+			for (size_t m = 0; m < maps.size(); ++m)
+				if (result->prepared[m]->problem.rfind("could not be prepared", 0) != 0)  // a failure is tried again
+					prepared_memory_[robot_of[m]] = {versions[m], result->prepared[m]};
+			// Every fresh alignment, as the aligner gave it: one dropped around a
+			// cycle is dropped again while its maps stay as they are.
 			for (const FleetEdge& e : result->edges)
 			{
-				// Fresh alignments only; one dropped around a cycle is suspect:
-				// aligned again next time.
-				if (e.reused || e.dropped) continue;
+				if (e.reused) continue;
+				const auto key = std::minmax(robot_of[e.to], robot_of[e.from]);
 				PairMemory mem;
 				mem.edge = e;
+				mem.edge.dropped = false;
+				if (!e.aligner_message.empty()) mem.edge.message = e.aligner_message;
 				mem.edge.to = robot_of[e.to], mem.edge.from = robot_of[e.from];
 				mem.to_version = versions[e.to], mem.from_version = versions[e.from];
 				mem.to_known = known_cells[e.to], mem.from_known = known_cells[e.from];
 				mem.estimation = estimation;
-				pair_memory_[std::minmax(mem.edge.to, mem.edge.from)] = mem;
+				const auto before = pair_memory_.find(key);
+				mem.searched = e.tracked && before != pair_memory_.end() ? before->second.searched : estimation;
+				pair_memory_[key] = mem;
 			}
-			for (FleetEdge& e : result->edges)
-				if (e.dropped) pair_memory_.erase(std::minmax(robot_of[e.to], robot_of[e.from]));
 			// The world is provisional until a second robot is placed in it: if
 			// its robot overlaps no one (another building, a robot far away)
 			// while others overlap each other, the world moves to the largest
-			// group, on the pairs already aligned (placeFleet aligned them all,
-			// nobody being settled).
+			// group, on the pairs aligned so far.
 			const bool alone = std::none_of(result->maps.begin(), result->maps.end(), [&](const FleetPlacement& p) {
 				return p.placed && &p != &result->maps[world];
 			});

@@ -43,8 +43,11 @@ struct LiveFleetParams
 	 * a search). A refused pair is tried again once one of its maps has this
 	 * much more known cells than at the refusal... */
 	double retry_growth = 0.1;
-	/** ...or this many estimations after it, if a map of it changed at all. */
-	size_t retry_estimations = 10;
+	/** ...or this many estimations after it, if a map of it changed at all.
+	 * A tracked pair is searched afresh as often (and while a move of its
+	 * robot awaits confirmation), so that a wrong placement cannot confirm
+	 * itself. */
+	size_t retry_estimations = 5;
 	/** No pair alignment starts after this many seconds of an estimation
 	 * (0: no limit); the pairs left wait for the next one, their earlier
 	 * results standing in. Keeps an estimation near its period. */
@@ -127,6 +130,7 @@ class LiveFleet
 		size_t to_version = 0, from_version = 0;
 		size_t to_known = 0, from_known = 0;  //!< known cells of each map then
 		size_t estimation = 0;  //!< when
+		size_t searched = 0;  //!< when last searched afresh (not tracked)
 	};
 	struct PreparedMemory
 	{
