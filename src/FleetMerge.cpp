@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -270,7 +271,7 @@ FleetResult placeFleet(
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();
 	std::vector<FleetEdge> edges;
-	std::map<std::pair<size_t, size_t>, bool> done;  // unordered pair → aligned, reused or deferred
+	std::set<std::pair<size_t, size_t>> done;  // unordered pairs aligned, reused or deferred
 	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
 
 	// Round 1: everything against the reference (the two-map case exactly).
@@ -288,7 +289,7 @@ FleetResult placeFleet(
 		std::vector<PairToAlign> to_align;
 		for (const auto& [to, from] : todo)
 		{
-			done[key(to, from)] = true;
+			done.insert(key(to, from));
 			std::optional<FleetHints::Known> known;
 			if (hints.known) known = hints.known(to, from);
 			if (known && known->holds)
