@@ -240,9 +240,12 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 	p.true_overlap = trueOverlap(metricEdges(ref), other_edges, truth, coarse);
 	{
 		const Similarity2D truth_cells = ref.cellToMapFrame().inverse().compose(truth).compose(other.cellToMapFrame());
-		const TsICPResult at_truth = runTsICP(
-			edgePoints(toClassImage(ref.grid)), edgePoints(toClassImage(other.grid)), truth_cells, aligner.options.icpParams());
-		p.floor_rmse = pointRmse(ref.cellToMapFrame().compose(at_truth.transform).compose(other.cellToMapFrame().inverse()),
+		// The aligner's last refinement, started at the truth.
+		const Similarity2D at_truth = aligner.options.icp_finish_on_occupied
+			? aligner.finishOnOccupied(*aligner.prepare(ref.grid), *aligner.prepare(other.grid), truth_cells)
+			: runTsICP(edgePoints(toClassImage(ref.grid)), edgePoints(toClassImage(other.grid)), truth_cells,
+					   aligner.options.icpParams()).transform;
+		p.floor_rmse = pointRmse(ref.cellToMapFrame().compose(at_truth).compose(other.cellToMapFrame().inverse()),
 								 truth, other_edges) / coarse;
 	}
 	const auto cm_of = [](double res) { return std::to_string(std::lround(res * 100)) + "cm"; };

@@ -8,6 +8,7 @@
 #include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/system/CTicTac.h>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 
@@ -43,6 +44,8 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_relative_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_coarse_points, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(icp_finish_on_occupied, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(finish_max_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
@@ -79,6 +82,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("icp_max_iterations", icp_max_iterations, 1, 1e5);
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
 	in("icp_coarse_points", icp_coarse_points, 0, 1e9);
+	in("finish_max_shift", finish_max_shift, 0, 100);
 	in("verify_tolerance", verify_tolerance, 0.5, 50);
 	in("verify_shift", verify_shift, 1, 1000);
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
@@ -110,6 +114,8 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
@@ -201,18 +207,76 @@ double shareOnKnown(const PointList& points, const Similarity2D& t, const Occupa
 	return double(on) / points.size();
 }
 
+/** How far `to` moves `points` from where `from` puts them (reference
+ * cells), over those that `from` puts on the reference's known space. */
+double largestShift(const PointList& points, const Similarity2D& from, const Similarity2D& to, const OccupancyField& ref)
+{
+	double shift = 0;
+	const Eigen::Matrix2d a = from.linear(), b = to.linear();
+	for (const auto& p : points)
+	{
+		const Eigen::Vector2d q = a * p + from.t;
+		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+		if (x >= 0 && y >= 0 && x < ref.known.cols && y < ref.known.rows && ref.known.at<uint8_t>(y, x))
+			shift = std::max(shift, (b * p + to.t - q).norm());
+	}
+	return shift;
+}
+
+/** The points that `t` puts within `margin` target cells of the target's
+ * known space. The margin keeps whole walls: the space behind a wall is
+ * unknown, and a wall band cut where the other map's knowledge ends would
+ * pull the fit to one side. */
+PointList nearKnown(const PointList& points, const Similarity2D& t, const OccupancyField& target, double margin)
+{
+	const int r = std::max(1, int(std::ceil(margin)));
+	cv::Mat near;
+	cv::dilate(target.known, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1)));
+	PointList inside;
+	const Eigen::Matrix2d a = t.linear();
+	for (const auto& p : points)
+	{
+		const Eigen::Vector2d q = a * p + t.t;
+		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+		if (x >= 0 && y >= 0 && x < near.cols && y < near.rows && near.at<uint8_t>(y, x)) inside.push_back(p);
+	}
+	return inside;
+}
+
+/** TsICP on the occupied cells both maps see (their overlap under `cells`),
+ * from `cells`, the coarser map's cells as the fixed set: each coarse cell
+ * centre lies inside the band the finer map draws a wall with and finds its
+ * partner there, while a fine point finds a coarse centre up to half a coarse
+ * cell off, to one side or the other. Returns `cells` when the overlap is too
+ * thin to refine on. */
+Similarity2D finishOnOccupiedCells(
+	const CScalingGridMapAligner::TPreparedMap& ref, const CScalingGridMapAligner::TPreparedMap& other,
+	const Similarity2D& cells, const TsICPParams& ip)
+{
+	// Two cells of the coarser map, in each target's cells.
+	const double coarse_in_ref = std::max(1.0, cells.scale), coarse_in_other = coarse_in_ref / cells.scale;
+	const PointList ref_seen = nearKnown(ref.occupied, cells.inverse(), other.field, 2 * coarse_in_other);
+	const PointList other_seen = nearKnown(other.occupied, cells, ref.field, 2 * coarse_in_ref);
+	if (ref_seen.size() < 10 || other_seen.size() < 10) return cells;
+	const bool other_coarser = cells.scale > 1;
+	const TsICPResult r = other_coarser ? runTsICP(other_seen, ref_seen, cells.inverse(), ip)
+										: runTsICP(ref_seen, other_seen, cells, ip);
+	const Similarity2D t = other_coarser ? r.transform.inverse() : r.transform;
+	return t.isFinite() && t.scale > 0 ? t : cells;
+}
+
 /** TsICP trims to the share ξ ≥ ξmin of its fixed set's points that find a
  * partner, so the fixed set should be the map that lies more inside the
  * other (a small map inside a large one): judged at the start transform.
  * The result is always other → ref, in reference cells. */
 TsICPResult refineFromTheInside(
-	const PointList& ref_edges, const OccupancyField& ref_field, const PointList& other_edges,
+	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
 	const OccupancyField& other_field, const Similarity2D& start, const TsICPParams& ip)
 {
-	const double ref_inside = shareOnKnown(ref_edges, start.inverse(), other_field);
-	const double other_inside = shareOnKnown(other_edges, start, ref_field);
-	if (other_inside <= ref_inside) return runTsICP(ref_edges, other_edges, start, ip);
-	TsICPResult r = runTsICP(other_edges, ref_edges, start.inverse(), ip);
+	const double ref_inside = shareOnKnown(ref_points, start.inverse(), other_field);
+	const double other_inside = shareOnKnown(other_points, start, ref_field);
+	if (other_inside <= ref_inside) return runTsICP(ref_points, other_points, start, ip);
+	TsICPResult r = runTsICP(other_points, ref_points, start.inverse(), ip);
 	const double s2 = 1.0 / (r.transform.scale * r.transform.scale);  // other cells² → ref cells²
 	r.transform = r.transform.inverse();
 	r.trimmed_mse *= s2;
@@ -258,9 +322,16 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 	// 2. Edge points, and what the verification judges them against.
 	stage.Tic();
 	p->edges = edgePoints(p->classes);
+	if (options.icp_finish_on_occupied) p->occupied = occupiedPoints(p->classes);
 	p->field = occupancyField(p->classes);
 	p->stage_seconds["edges"] = stage.Tac();
 	return p;
+}
+
+Similarity2D CScalingGridMapAligner::finishOnOccupied(
+	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells) const
+{
+	return finishOnOccupiedCells(ref, other, cells, options.icpParams());
 }
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
@@ -459,6 +530,19 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return fail(info.hypotheses ? "no hypothesis survived refinement"
 									: "no consistent feature matches or structure between the maps (do they overlap?)");
 
+	// The decided transform finished on the occupied cells (icp_finish_on_occupied).
+	if (options.icp_finish_on_occupied && info.confidence >= options.min_confidence)
+	{
+		stage.Tic();
+		const Similarity2D finished = finishOnOccupiedCells(ref, other, info.cells, ip);
+		const double shift = largestShift(other_edges, info.cells, finished, ref_field);
+		const double coarse = std::max(1.0, info.cells.scale);
+		if (shift <= options.finish_max_shift * coarse)
+			info.cells = finished;
+		else
+			MRPT_LOG_DEBUG_STREAM("finish on occupied cells not taken: it moves a wall by " << shift / coarse << " coarse cells");
+		info.stage_seconds["finish"] = stage.Tac();
+	}
 	info.metric = ref.cell_to_metric.compose(info.cells).compose(other.cell_to_metric.inverse());
 	info.implied_resolution_other = info.cells.scale * ref.resolution;
 	info.executionTime = total.Tac();

@@ -56,6 +56,13 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		int icp_max_iterations = 100;
 		double icp_relative_tolerance = 1e-7;
 		int icp_coarse_points = 0;   //!< TsICPParams::coarse_points
+		/** The decided transform is refined once more by TsICP on every
+		 * occupied cell of both maps (EdgePoints.h, occupiedPoints): edges
+		 * are staircases that differ between resolutions and rotations. The
+		 * decision is made before, on the edges; this moves the transform by
+		 * a fraction of a cell (more than finish_max_shift: not taken). */
+		bool icp_finish_on_occupied = true;
+		double finish_max_shift = 1.5;  //!< cells of the coarser map
 		// --- Decision (README "How the decision works"; calibrated by
 		// scripts/calibrate_decision.py on Halmstad E5/HIH and CARMEN negatives)
 		/** Walls within this many cells of the coarser map agree: independent
@@ -145,7 +152,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		size_t hypotheses = 0, hypotheses_refined = 0;
 		size_t ref_edge_points = 0, other_edge_points = 0;
 		std::vector<double> objective_history;
-		std::map<std::string, double> stage_seconds;  //!< features, ransac, edges, icp, verify
+		/** features, ransac, edges, icp, verify, structure, finish. icp and
+		 * verify add up the hypotheses, which run a few at once: together
+		 * they can exceed the wall time. */
+		std::map<std::string, double> stage_seconds;
 	};
 
 	/** One map as the aligner sees it: its class image, feature pyramid,
@@ -164,6 +174,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		FeatureParams feature_params;  //!< those the features were extracted with
 		std::vector<LevelFeatures> features;
 		PointList edges;
+		PointList occupied;  //!< with icp_finish_on_occupied, else empty
 		OccupancyField field;
 		std::map<std::string, double> stage_seconds;  //!< features, edges
 	};
@@ -172,6 +183,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	/** Prepares one map with these options. Never throws on bad content:
 	 * the map's `problem` says what is wrong. */
 	PreparedMapPtr prepare(const mrpt::maps::COccupancyGridMap2D& grid) const;
+
+	/** The finish on occupied cells (icp_finish_on_occupied) of a transform
+	 * between prepared maps' cells, on its own: what align() applies to the
+	 * decided transform (when it moves no wall by more than
+	 * finish_max_shift), exposed so the benchmark can start it from the truth. */
+	Similarity2D finishOnOccupied(const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells) const;
 
 	/** The full similarity between two grids. Never throws on bad map
 	 * content: the reason is in TReturnInfo::message with success = false. */

@@ -13,4 +13,10 @@ namespace multires_map_merge
  * among their 8 neighbours. */
 PointList edgePoints(const cv::Mat& classes);
 
+/** Every occupied cell, same coordinates. A wall's edge is a staircase whose
+ * steps depend on the resolution and on how the wall lies on the lattice; the
+ * wall's occupied cells, taken whole, sit where the wall is: the aligner
+ * finishes on these (TConfigParams::icp_finish_on_occupied). */
+PointList occupiedPoints(const cv::Mat& classes);
+
 }  // namespace multires_map_merge
