@@ -192,18 +192,20 @@ constexpr size_t kMinJudgedPoints = 40;
 
 namespace
 {
+/** Whether `q` (target cells) rounds to a set cell of `mask`. */
+bool onMask(const cv::Mat& mask, const Eigen::Vector2d& q)
+{
+	const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
+	return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x);
+}
+
 /** Share of `points` that `t` moves onto the target's known space. */
 double shareOnKnown(const PointList& points, const Similarity2D& t, const OccupancyField& target)
 {
 	if (points.empty()) return 0;
 	size_t on = 0;
 	const Eigen::Matrix2d a = t.linear();
-	for (const auto& p : points)
-	{
-		const Eigen::Vector2d q = a * p + t.t;
-		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
-		on += x >= 0 && y >= 0 && x < target.known.cols && y < target.known.rows && target.known.at<uint8_t>(y, x);
-	}
+	for (const auto& p : points) on += onMask(target.known, a * p + t.t);
 	return double(on) / points.size();
 }
 
@@ -216,9 +218,7 @@ double largestShift(const PointList& points, const Similarity2D& from, const Sim
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + from.t;
-		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
-		if (x >= 0 && y >= 0 && x < ref.known.cols && y < ref.known.rows && ref.known.at<uint8_t>(y, x))
-			shift = std::max(shift, (b * p + to.t - q).norm());
+		if (onMask(ref.known, q)) shift = std::max(shift, (b * p + to.t - q).norm());
 	}
 	return shift;
 }
@@ -235,11 +235,7 @@ PointList nearKnown(const PointList& points, const Similarity2D& t, const Occupa
 	PointList inside;
 	const Eigen::Matrix2d a = t.linear();
 	for (const auto& p : points)
-	{
-		const Eigen::Vector2d q = a * p + t.t;
-		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
-		if (x >= 0 && y >= 0 && x < near.cols && y < near.rows && near.at<uint8_t>(y, x)) inside.push_back(p);
-	}
+		if (onMask(near, a * p + t.t)) inside.push_back(p);
 	return inside;
 }
 
@@ -255,8 +251,9 @@ Similarity2D finishOnOccupiedCells(
 {
 	// Two cells of the coarser map, in each target's cells.
 	const double coarse_in_ref = std::max(1.0, cells.scale), coarse_in_other = coarse_in_ref / cells.scale;
-	const PointList ref_seen = nearKnown(ref.occupied, cells.inverse(), other.field, 2 * coarse_in_other);
-	const PointList other_seen = nearKnown(other.occupied, cells, ref.field, 2 * coarse_in_ref);
+	// From the classes here rather than kept prepared: only merged pairs pay.
+	const PointList ref_seen = nearKnown(occupiedPoints(ref.classes), cells.inverse(), other.field, 2 * coarse_in_other);
+	const PointList other_seen = nearKnown(occupiedPoints(other.classes), cells, ref.field, 2 * coarse_in_ref);
 	if (ref_seen.size() < 10 || other_seen.size() < 10) return cells;
 	const bool other_coarser = cells.scale > 1;
 	const TsICPResult r = other_coarser ? runTsICP(other_seen, ref_seen, cells.inverse(), ip)
@@ -322,7 +319,6 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 	// 2. Edge points, and what the verification judges them against.
 	stage.Tic();
 	p->edges = edgePoints(p->classes);
-	if (options.icp_finish_on_occupied) p->occupied = occupiedPoints(p->classes);
 	p->field = occupancyField(p->classes);
 	p->stage_seconds["edges"] = stage.Tac();
 	return p;

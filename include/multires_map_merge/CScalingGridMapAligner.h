@@ -174,7 +174,6 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		FeatureParams feature_params;  //!< those the features were extracted with
 		std::vector<LevelFeatures> features;
 		PointList edges;
-		PointList occupied;  //!< with icp_finish_on_occupied, else empty
 		OccupancyField field;
 		std::map<std::string, double> stage_seconds;  //!< features, edges
 	};

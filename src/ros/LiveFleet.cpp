@@ -56,9 +56,10 @@ bool LiveFleet::hasRobot(const std::string& name) const
 
 std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::OccupancyGrid& msg)
 {
+	std::shared_ptr<const GridInFrame> grid;
 	try
 	{
-		gridFromMsg(msg, robot + "'s map");  // validates: a bad map never replaces a good one
+		grid = std::make_shared<const GridInFrame>(gridFromMsg(msg, robot + "'s map"));  // a bad map never replaces a good one
 	}
 	catch (const std::exception& e)
 	{
@@ -76,6 +77,8 @@ std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::Occupancy
 	r->map = msg;
 	if (same) return "";
 	++r->map_version;
+	r->grid = std::move(grid), r->converted_version = r->map_version;
+	r->known_cells = size_t(std::count_if(msg.data.begin(), msg.data.end(), [](int8_t v) { return v >= 0; }));
 	++version_;
 	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
 	return "";
@@ -109,6 +112,17 @@ std::string LiveFleet::onUpdate(const std::string& robot, const map_msgs::Occupa
 	++r->map_version;
 	++version_;
 	return "";
+}
+
+const GridInFrame& LiveFleet::converted(Robot& r)
+{
+	if (r.converted_version != r.map_version)
+	{
+		r.grid = std::make_shared<const GridInFrame>(gridFromMsg(*r.map, r.name));  // validated on arrival
+		r.known_cells = size_t(std::count_if(r.map->data.begin(), r.map->data.end(), [](int8_t v) { return v >= 0; }));
+		r.converted_version = r.map_version;
+	}
+	return *r.grid;
 }
 
 bool LiveFleet::agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const
@@ -167,15 +181,15 @@ void LiveFleet::estimate()
 		}
 		if (world_robot_.empty()) return;
 		for (size_t i = 0; i < robots_.size(); ++i)
-			if (const Robot& r = robots_[i]; r.map)
+			if (Robot& r = robots_[i]; r.map)
 			{
 				if (r.name == world_robot_) world = names.size();
 				names.push_back(r.name);
-				maps.push_back(gridFromMsg(*r.map, r.name));  // validated on arrival
+				maps.push_back(converted(r));
 				robot_of.push_back(i);
 				versions.push_back(r.map_version);
 				pending.push_back(r.pending.has_value());
-				known_cells.push_back(size_t(std::count_if(r.map->data.begin(), r.map->data.end(), [](int8_t v) { return v >= 0; })));
+				known_cells.push_back(r.known_cells);
 			}
 	}
 	// What the last estimations found and still holds (LiveFleetParams).
@@ -332,11 +346,11 @@ std::optional<nav_msgs::OccupancyGrid> LiveFleet::merged(const std::string& worl
 			return merged_cache_;
 		}
 		version = version_;
-		for (const auto& r : robots_)
+		for (auto& r : robots_)
 			if (r.map && r.placed)
 			{
 				if (r.name == world_robot_) ref = maps.size();
-				maps.push_back(gridFromMsg(*r.map, r.name));
+				maps.push_back(converted(r));
 				FleetPlacement p;
 				p.placed = true, p.in_reference = r.in_world, p.confidence = r.confidence;
 				placement.maps.push_back(p);

@@ -19,6 +19,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -122,6 +123,10 @@ class LiveFleet
 		std::optional<Similarity2D> pending;  //!< a disagreeing estimate awaiting confirmation
 		std::string message;
 		size_t map_version = 0;  //!< bumped by every map or update taken
+		/** `map` as a grid, and its known cells, at `converted_version`:
+		 * converted once per map version, not once per estimation. */
+		std::shared_ptr<const GridInFrame> grid;
+		size_t known_cells = 0, converted_version = size_t(-1);
 	};
 	/** A pair's last alignment and the maps it came from (estimate() only). */
 	struct PairMemory
@@ -137,6 +142,8 @@ class LiveFleet
 		size_t map_version = 0;
 		CScalingGridMapAligner::PreparedMapPtr prepared;
 	};
+	/** `r`'s map as a grid, converted if it changed since (lock held). */
+	const GridInFrame& converted(Robot& r);
 	Robot* find(const std::string& name);
 	const Robot* find(const std::string& name) const;
 	bool agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const;
