@@ -1,6 +1,7 @@
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/LatticeShift.h>
 #include <multires_map_merge/MapAgreement.h>
 #include <multires_map_merge/StructureHypotheses.h>
 
@@ -46,6 +47,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(icp_coarse_points, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_finish_on_occupied, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_max_shift, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(finish_lattice_step, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
@@ -83,6 +85,8 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
 	in("icp_coarse_points", icp_coarse_points, 0, 1e9);
 	in("finish_max_shift", finish_max_shift, 0, 100);
+	if (finish_lattice_step != 0)  // 0 turns it off; finer steps only cost time
+		in("finish_lattice_step", finish_lattice_step, 0.01, 0.5);
 	in("verify_tolerance", verify_tolerance, 0.5, 50);
 	in("verify_shift", verify_shift, 1, 1000);
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
@@ -116,6 +120,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_lattice_step, "Step of the finish's sub-cell shift on the coarser lattice (0: off) [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
@@ -140,6 +145,13 @@ FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
 	p.ransac_iterations = ransac_iterations;
 	p.min_inliers = ransac_min_inliers;
 	p.hypotheses_per_level_pair = hypotheses_per_level_pair;
+	return p;
+}
+
+LatticeShiftParams CScalingGridMapAligner::TConfigParams::latticeParams() const
+{
+	LatticeShiftParams p;
+	p.step = finish_lattice_step;
 	return p;
 }
 
@@ -243,11 +255,12 @@ PointList nearKnown(const PointList& points, const Similarity2D& t, const Occupa
  * from `cells`, the coarser map's cells as the fixed set: each coarse cell
  * centre lies inside the band the finer map draws a wall with and finds its
  * partner there, while a fine point finds a coarse centre up to half a coarse
- * cell off, to one side or the other. Returns `cells` when the overlap is too
- * thin to refine on. */
+ * cell off, to one side or the other. The coarse centres keep the coarse
+ * map's rounding, which `lattice` then takes out (LatticeShift.h). Returns
+ * `cells` when the overlap is too thin to refine on. */
 Similarity2D finishOnOccupiedCells(
 	const CScalingGridMapAligner::TPreparedMap& ref, const CScalingGridMapAligner::TPreparedMap& other,
-	const Similarity2D& cells, const TsICPParams& ip)
+	const Similarity2D& cells, const TsICPParams& ip, const LatticeShiftParams& lattice)
 {
 	// Two cells of the coarser map, in each target's cells.
 	const double coarse_in_ref = std::max(1.0, cells.scale), coarse_in_other = coarse_in_ref / cells.scale;
@@ -256,9 +269,20 @@ Similarity2D finishOnOccupiedCells(
 	const PointList other_seen = nearKnown(occupiedPoints(other.classes), cells, ref.field, 2 * coarse_in_ref);
 	if (ref_seen.size() < 10 || other_seen.size() < 10) return cells;
 	const bool other_coarser = cells.scale > 1;
-	const TsICPResult r = other_coarser ? runTsICP(other_seen, ref_seen, cells.inverse(), ip)
-										: runTsICP(ref_seen, other_seen, cells, ip);
-	const Similarity2D t = other_coarser ? r.transform.inverse() : r.transform;
+	const PointList& coarse_seen = other_coarser ? other_seen : ref_seen;
+	const PointList& fine_seen = other_coarser ? ref_seen : other_seen;
+	const TsICPResult r = runTsICP(coarse_seen, fine_seen, other_coarser ? cells.inverse() : cells, ip);
+	Similarity2D fine_to_coarse = r.transform;
+	if (lattice.step > 0 && fine_to_coarse.isFinite())
+	{
+		PointList fine_in_coarse(fine_seen.size());
+		const Eigen::Matrix2d a = fine_to_coarse.linear();
+		for (size_t i = 0; i < fine_seen.size(); ++i) fine_in_coarse[i] = a * fine_seen[i] + fine_to_coarse.t;
+		const auto& coarse = other_coarser ? other : ref;
+		const Eigen::Vector2d shift = latticeShift(fine_in_coarse, coarse_seen, coarse.field.known, lattice);
+		fine_to_coarse = Similarity2D(1, 0, shift).compose(fine_to_coarse);
+	}
+	const Similarity2D t = other_coarser ? fine_to_coarse.inverse() : fine_to_coarse;
 	return t.isFinite() && t.scale > 0 ? t : cells;
 }
 
@@ -327,7 +351,7 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 Similarity2D CScalingGridMapAligner::finishOnOccupied(
 	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells) const
 {
-	return finishOnOccupiedCells(ref, other, cells, options.icpParams());
+	return finishOnOccupiedCells(ref, other, cells, options.icpParams(), options.latticeParams());
 }
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
@@ -530,7 +554,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	if (options.icp_finish_on_occupied && info.confidence >= options.min_confidence)
 	{
 		stage.Tic();
-		const Similarity2D finished = finishOnOccupiedCells(ref, other, info.cells, ip);
+		const Similarity2D finished = finishOnOccupiedCells(ref, other, info.cells, ip, options.latticeParams());
 		const double shift = largestShift(other_edges, info.cells, finished, ref_field);
 		const double coarse = std::max(1.0, info.cells.scale);
 		if (shift <= options.finish_max_shift * coarse)

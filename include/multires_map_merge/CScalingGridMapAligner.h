@@ -12,6 +12,7 @@
 
 #include <multires_map_merge/FeatureHypotheses.h>
 #include <multires_map_merge/GridInFrame.h>
+#include <multires_map_merge/LatticeShift.h>
 #include <multires_map_merge/MapAgreement.h>
 #include <multires_map_merge/Similarity2D.h>
 #include <multires_map_merge/TsICP.h>
@@ -63,6 +64,11 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * a fraction of a cell (more than finish_max_shift: not taken). */
 		bool icp_finish_on_occupied = true;
 		double finish_max_shift = 1.5;  //!< cells of the coarser map
+		/** The finish's last step (LatticeShift.h): the sub-cell shift that
+		 * makes the finer map's occupied cells, drawn on the coarser map's
+		 * lattice, cover the coarser map's, searched in steps of this many
+		 * coarse cells over ± half a cell (0: off). */
+		double finish_lattice_step = 0.05;
 		// --- Decision (README "How the decision works"; calibrated by
 		// scripts/calibrate_decision.py on Halmstad E5/HIH and CARMEN negatives)
 		/** Walls within this many cells of the coarser map agree: independent
@@ -102,6 +108,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
+		LatticeShiftParams latticeParams() const;
 	} options;
 
 	/** One refined hypothesis and how it was judged. */
