@@ -201,7 +201,7 @@ double trueOverlap(const PointList& ref_edges, const PointList& other_edges, con
 	PointList moved = other_edges;
 	for (auto& p : moved) p = truth(p);
 	if (moved.empty() || ref_edges.empty()) return 0;
-	const PointKDTree tree(moved);
+	const PointKDTree tree(std::move(moved));
 	size_t near = 0;
 	for (const auto& q : ref_edges) near += tree.nearest(q).second <= coarse * coarse;
 	return double(near) / ref_edges.size();

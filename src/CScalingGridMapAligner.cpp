@@ -3,6 +3,7 @@
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/LatticeShift.h>
 #include <multires_map_merge/MapAgreement.h>
+#include <multires_map_merge/PointKDTree.h>
 #include <multires_map_merge/StructureHypotheses.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -235,19 +236,16 @@ double largestShift(const PointList& points, const Similarity2D& from, const Sim
 	return shift;
 }
 
-/** The points that `t` puts within `margin` target cells of the target's
- * known space. The margin keeps whole walls: the space behind a wall is
- * unknown, and a wall band cut where the other map's knowledge ends would
- * pull the fit to one side. */
-PointList nearKnown(const PointList& points, const Similarity2D& t, const OccupancyField& target, double margin)
+/** The points that `t` puts on `near_known` (a target's knownWithin). The
+ * margin keeps whole walls: the space behind a wall is unknown, and a wall
+ * band cut where the other map's knowledge ends would pull the fit to one
+ * side. */
+PointList nearKnown(const PointList& points, const Similarity2D& t, const cv::Mat& near_known)
 {
-	const int r = std::max(1, int(std::ceil(margin)));
-	cv::Mat near;
-	cv::dilate(target.known, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1)));
 	PointList inside;
 	const Eigen::Matrix2d a = t.linear();
 	for (const auto& p : points)
-		if (onMask(near, a * p + t.t)) inside.push_back(p);
+		if (onMask(near_known, a * p + t.t)) inside.push_back(p);
 	return inside;
 }
 
@@ -264,9 +262,11 @@ Similarity2D finishOnOccupiedCells(
 {
 	// Two cells of the coarser map, in each target's cells.
 	const double coarse_in_ref = std::max(1.0, cells.scale), coarse_in_other = coarse_in_ref / cells.scale;
+	const cv::Mat ref_near_known = knownWithin(ref.field.known, 2 * coarse_in_ref);
+	const cv::Mat other_near_known = knownWithin(other.field.known, 2 * coarse_in_other);
 	// From the classes here rather than kept prepared: only merged pairs pay.
-	const PointList ref_seen = nearKnown(occupiedPoints(ref.classes), cells.inverse(), other.field, 2 * coarse_in_other);
-	const PointList other_seen = nearKnown(occupiedPoints(other.classes), cells, ref.field, 2 * coarse_in_ref);
+	const PointList ref_seen = nearKnown(occupiedPoints(ref.classes), cells.inverse(), other_near_known);
+	const PointList other_seen = nearKnown(occupiedPoints(other.classes), cells, ref_near_known);
 	if (ref_seen.size() < 10 || other_seen.size() < 10) return cells;
 	const bool other_coarser = cells.scale > 1;
 	const PointList& coarse_seen = other_coarser ? other_seen : ref_seen;
@@ -278,8 +278,9 @@ Similarity2D finishOnOccupiedCells(
 		PointList fine_in_coarse(fine_seen.size());
 		const Eigen::Matrix2d a = fine_to_coarse.linear();
 		for (size_t i = 0; i < fine_seen.size(); ++i) fine_in_coarse[i] = a * fine_seen[i] + fine_to_coarse.t;
-		const auto& coarse = other_coarser ? other : ref;
-		const Eigen::Vector2d shift = latticeShift(fine_in_coarse, coarse_seen, coarse.field.known, lattice);
+		// Two cells of the coarse map: what latticeShift counts extras on.
+		const cv::Mat& coarse_near_known = other_coarser ? other_near_known : ref_near_known;
+		const Eigen::Vector2d shift = latticeShift(fine_in_coarse, coarse_seen, coarse_near_known, lattice);
 		fine_to_coarse = Similarity2D(1, 0, shift).compose(fine_to_coarse);
 	}
 	const Similarity2D t = other_coarser ? fine_to_coarse.inverse() : fine_to_coarse;
@@ -291,13 +292,13 @@ Similarity2D finishOnOccupiedCells(
  * other (a small map inside a large one): judged at the start transform.
  * The result is always other → ref, in reference cells. */
 TsICPResult refineFromTheInside(
-	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& start, const TsICPParams& ip)
+	const CScalingGridMapAligner::TPreparedMap& ref, const CScalingGridMapAligner::TPreparedMap& other,
+	const Similarity2D& start, const TsICPParams& ip)
 {
-	const double ref_inside = shareOnKnown(ref_points, start.inverse(), other_field);
-	const double other_inside = shareOnKnown(other_points, start, ref_field);
-	if (other_inside <= ref_inside) return runTsICP(ref_points, other_points, start, ip);
-	TsICPResult r = runTsICP(other_points, ref_points, start.inverse(), ip);
+	const double ref_inside = shareOnKnown(ref.edges, start.inverse(), other.field);
+	const double other_inside = shareOnKnown(other.edges, start, ref.field);
+	if (other_inside <= ref_inside) return runTsICP(ref.edges, *other.edge_tree, start, ip);
+	TsICPResult r = runTsICP(other.edges, *ref.edge_tree, start.inverse(), ip);
 	const double s2 = 1.0 / (r.transform.scale * r.transform.scale);  // other cells² → ref cells²
 	r.transform = r.transform.inverse();
 	r.trimmed_mse *= s2;
@@ -343,6 +344,7 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 	// 2. Edge points, and what the verification judges them against.
 	stage.Tic();
 	p->edges = edgePoints(p->classes);
+	if (p->edges.size() >= 3) p->edge_tree = std::make_shared<const PointKDTree>(p->edges);
 	p->field = occupancyField(p->classes);
 	p->stage_seconds["edges"] = stage.Tac();
 	return p;
@@ -426,7 +428,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
 		mrpt::system::CTicTac clock;
-		const TsICPResult r = refineFromTheInside(ref_edges, ref_field, other_edges, other_field, h.other_to_ref, ip);
+		const TsICPResult r = refineFromTheInside(ref, other, h.other_to_ref, ip);
 		out.icp_s = clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0)) return out;
 		if (expected_scale &&

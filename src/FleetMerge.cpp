@@ -18,6 +18,11 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
+std::string FleetEdge::describe() const
+{
+	return dropped ? "dropped: contradicts the other alignments around a cycle (" + message + ")" : message;
+}
+
 double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b)
 {
 	const Similarity2D cells = map.cellToMapFrame();
@@ -130,11 +135,11 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 			e.tracked = r.tracked;
 			e.from_to_to = betweenMapFrames(maps[e.to], r.metric, maps[e.from]);
 			e.confidence = r.success ? r.confidence : 0.0;
-			e.message = e.aligner_message = r.message;
+			e.message = r.message;
 		}
 		catch (const std::exception& ex)
 		{
-			e.message = e.aligner_message = ex.what();
+			e.message = ex.what();
 		}
 	});
 	return out;
@@ -228,10 +233,6 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 			return edges[a].confidence < edges[b].confidence;
 		});
 		edges[weakest].dropped = true;
-		std::ostringstream why;
-		why << "dropped: contradicts the other alignments around a cycle ("
-			<< (edges[weakest].aligner_message.empty() ? edges[weakest].message : edges[weakest].aligner_message) << ")";
-		edges[weakest].message = why.str();
 	}
 }
 }  // namespace
@@ -257,7 +258,7 @@ FleetResult placeFromPairs(
 		std::ostringstream why;
 		why << "not placed: no confident alignment connects it to the reference";
 		if (best)
-			why << " (closest: map " << (best->from == m ? best->to : best->from) << ", " << best->message << ")";
+			why << " (closest: map " << (best->from == m ? best->to : best->from) << ", " << best->describe() << ")";
 		out.maps[m].message = why.str();
 	}
 	return out;

@@ -1,7 +1,6 @@
 #include <multires_map_merge/LatticeShift.h>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -35,16 +34,14 @@ size_t mismatch(
 }  // namespace
 
 Eigen::Vector2d latticeShift(
-	const PointList& fine_in_coarse, const PointList& coarse_seen, const cv::Mat& coarse_known,
+	const PointList& fine_in_coarse, const PointList& coarse_seen, const cv::Mat& coarse_near_known,
 	const LatticeShiftParams& p)
 {
-	CV_Assert(coarse_known.type() == CV_8UC1);
+	CV_Assert(coarse_near_known.type() == CV_8UC1);
 	if (fine_in_coarse.empty() || coarse_seen.empty() || !(p.step > 0) || !(p.range > 0)) return {0, 0};
-	cv::Mat seen = cv::Mat::zeros(coarse_known.size(), CV_8U);
+	// The seen cells are a subset of the occupied ones (points, not a mask).
+	cv::Mat seen = cv::Mat::zeros(coarse_near_known.size(), CV_8U);
 	for (const auto& c : coarse_seen) seen.at<uint8_t>(int(c.y()), int(c.x())) = 1;
-	// Known within two cells: walls at the edge of what the coarse map saw.
-	cv::Mat near_known;
-	cv::dilate(coarse_known, near_known, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
 
 	// Two passes: the whole range at four steps, then around its answer.
 	// Steps bounded below: the work grows with (range / step)².
@@ -57,11 +54,11 @@ Eigen::Vector2d latticeShift(
 		const int side = 2 * n + 1;
 		std::vector<size_t> cost(size_t(side) * side);
 		cv::parallel_for_(cv::Range(0, side * side), [&](const cv::Range& r) {
-			cv::Mat stamp = cv::Mat::zeros(coarse_known.size(), CV_32S);
+			cv::Mat stamp = cv::Mat::zeros(coarse_near_known.size(), CV_32S);
 			for (int k = r.start; k < r.end; ++k)
 			{
 				const Eigen::Vector2d shift = centre + step * Eigen::Vector2d(k % side - n, k / side - n);
-				cost[size_t(k)] = mismatch(fine_in_coarse, shift, seen, near_known, coarse_seen.size(), stamp, k + 1);
+				cost[size_t(k)] = mismatch(fine_in_coarse, shift, seen, coarse_near_known, coarse_seen.size(), stamp, k + 1);
 			}
 		});
 		const size_t least = *std::min_element(cost.begin(), cost.end());

@@ -65,6 +65,14 @@ OccupancyField occupancyField(const cv::Mat& classes)
 	return f;
 }
 
+cv::Mat knownWithin(const cv::Mat& known, double cells)
+{
+	const int r = std::max(1, int(std::ceil(cells)));
+	cv::Mat near;
+	cv::dilate(known, near, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1)));
+	return near;
+}
+
 Support tolerantSupport(
 	const PointList& points, const Similarity2D& t, const OccupancyField& target, double tolerance)
 {

@@ -69,7 +69,7 @@ std::string fleetJson(
 						 {"merged", e.merged && !e.dropped},
 						 {"confidence", num(e.confidence)},
 						 {"transform", e.merged ? transformJson(e.from_to_to) : nlohmann::ordered_json()},
-						 {"message", e.message}});
+						 {"message", e.describe()}});
 	const nlohmann::ordered_json j = {
 		{"success", error.empty() && r.allPlaced()},
 		{"reference", name(int(reference))},

@@ -1,6 +1,7 @@
 #include <multires_map_merge/PointKDTree.h>
 
 #include <nanoflann.hpp>
+#include <utility>
 
 namespace multires_map_merge
 {
@@ -23,16 +24,17 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<
 
 struct PointKDTree::Impl
 {
-	explicit Impl(const PointList& p)
-		: adaptor{p}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16))
+	explicit Impl(PointList p)
+		: points(std::move(p)), adaptor{points}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16))
 	{
 		tree.buildIndex();
 	}
+	PointList points;  // before the adaptor and tree, which refer to it
 	PointListAdaptor adaptor;
 	Tree tree;
 };
 
-PointKDTree::PointKDTree(const PointList& points) : impl_(std::make_unique<Impl>(points))
+PointKDTree::PointKDTree(PointList points) : impl_(std::make_unique<Impl>(std::move(points)))
 {
 }
 PointKDTree::~PointKDTree() = default;
@@ -43,6 +45,11 @@ std::pair<size_t, double> PointKDTree::nearest(const Eigen::Vector2d& q) const
 	double d2 = 0;
 	impl_->tree.knnSearch(q.data(), 1, &idx, &d2);
 	return {static_cast<size_t>(idx), d2};
+}
+
+const PointList& PointKDTree::points() const
+{
+	return impl_->points;
 }
 
 }  // namespace multires_map_merge

@@ -134,12 +134,21 @@ TsICPResult runTsICP(
 {
 	if (ref.size() < 3 || other.size() < 3)
 		throw std::invalid_argument("TsICP needs at least 3 points in each set");
+	return runTsICP(ref, PointKDTree(other), start, p);
+}
+
+TsICPResult runTsICP(
+	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& start,
+	const TsICPParams& p)
+{
+	const PointList& other = other_tree.points();
+	if (ref.size() < 3 || other.size() < 3)
+		throw std::invalid_argument("TsICP needs at least 3 points in each set");
 	if (!start.isFinite() || !(start.scale > 0))
 		throw std::invalid_argument("TsICP start transform must be finite with scale > 0");
 	if (!(p.xi_min > 0 && p.xi_min <= 1))
 		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
 
-	const PointKDTree other_tree(other);
 	if (p.coarse_points <= 0 || ref.size() <= 2 * size_t(p.coarse_points))
 		return iterate(ref, other, other_tree, start, p, p.max_iterations);
 

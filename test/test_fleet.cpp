@@ -241,6 +241,9 @@ TEST(FleetGraph, AContradictedCycleDropsItsWeakestPairNotTheSharedPath)
 		expectNear(r.maps[m].in_reference, truth[m]);
 	}
 	EXPECT_TRUE(r.edges[3].dropped);
+	// Said, and the aligner's own words kept: a live fleet remembers them.
+	EXPECT_EQ(r.edges[3].describe().rfind("dropped: contradicts", 0), 0u) << r.edges[3].describe();
+	EXPECT_EQ(r.edges[3].message, edges[3].message);
 	EXPECT_FALSE(r.edges[0].dropped);
 	EXPECT_DOUBLE_EQ(r.maps[2].confidence, 0.55);  // as sure as the weakest pair on its path
 	EXPECT_EQ(r.maps[3].parent, 1);

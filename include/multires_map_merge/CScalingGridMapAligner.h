@@ -181,6 +181,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		FeatureParams feature_params;  //!< those the features were extracted with
 		std::vector<LevelFeatures> features;
 		PointList edges;
+		/** On `edges`, built once: every hypothesis's TsICP moves one map's
+		 * edges, either map's (null with fewer than 3 edge points). */
+		std::shared_ptr<const PointKDTree> edge_tree;
 		OccupancyField field;
 		std::map<std::string, double> stage_seconds;  //!< features, edges
 	};

@@ -29,7 +29,8 @@ struct FleetEdge
 	bool dropped = false;  //!< contradicted the others around a cycle
 	bool reused = false;  //!< an earlier result (FleetHints::known), not aligned in this call
 	bool tracked = false;  //!< refined from the earlier transform only (no global search)
-	std::string aligner_message;  //!< the aligner's, before any note of placing (`message`)
+	/** What became of it: the aligner's message, or why it was dropped. */
+	std::string describe() const;
 };
 
 struct FleetPlacement

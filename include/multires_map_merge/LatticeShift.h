@@ -26,10 +26,12 @@ struct LatticeShiftParams
 /** The shift (coarse cells) to add to `fine_in_coarse` (the finer map's
  * occupied cells, already in the coarse map's cell coordinates) that best
  * makes them, rounded to coarse cells, cover `coarse_seen` (the coarse map's
- * occupied cells the finer map sees) and nothing else the coarse map knows
- * (`coarse_known`, CV_8U, non-zero where known). Searched coarse to fine. */
+ * occupied cells the finer map sees) and nothing else the coarse map knows.
+ * `coarse_near_known` (CV_8U, non-zero where known) is what it knows grown by
+ * two cells (knownWithin), so that walls at the edge of what it saw count.
+ * Searched coarse to fine. */
 Eigen::Vector2d latticeShift(
-	const PointList& fine_in_coarse, const PointList& coarse_seen, const cv::Mat& coarse_known,
+	const PointList& fine_in_coarse, const PointList& coarse_seen, const cv::Mat& coarse_near_known,
 	const LatticeShiftParams& p = {});
 
 }  // namespace multires_map_merge

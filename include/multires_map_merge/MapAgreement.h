@@ -47,6 +47,10 @@ struct OccupancyField
 };
 OccupancyField occupancyField(const cv::Mat& classes);
 
+/** `known` grown by `cells` (rounded up, at least one) each way: the walls at
+ * the edge of what a map saw lie just outside its known space. */
+cv::Mat knownWithin(const cv::Mat& known, double cells);
+
 struct Support
 {
 	size_t judged = 0;  //!< points landing on the target's known space

@@ -1,6 +1,7 @@
 #pragma once
 // Nearest-neighbour queries on a fixed 2-D point list (nanoflann, as shipped
-// with MRPT). Built once per point set; TsICP queries it every iteration.
+// with MRPT). Built once per point set and kept with it (a prepared map holds
+// one for its edge points, which every hypothesis's TsICP queries).
 
 #include <multires_map_merge/TsICP.h>
 
@@ -11,13 +12,16 @@ namespace multires_map_merge
 class PointKDTree
 {
    public:
-	explicit PointKDTree(const PointList& points);
+	/** Keeps its own copy of the points, so that it can be shared and
+	 * outlive the list it was built from. */
+	explicit PointKDTree(PointList points);
 	~PointKDTree();
 	PointKDTree(const PointKDTree&) = delete;
 	PointKDTree& operator=(const PointKDTree&) = delete;
 
 	/** Index of the nearest point and its squared distance. */
 	std::pair<size_t, double> nearest(const Eigen::Vector2d& q) const;
+	const PointList& points() const;
 
    private:
 	struct Impl;

@@ -11,6 +11,7 @@
 namespace multires_map_merge
 {
 using PointList = std::vector<Eigen::Vector2d>;
+class PointKDTree;
 
 struct TsICPParams
 {
@@ -57,6 +58,12 @@ Trimming chooseOverlap(const std::vector<double>& sorted_sq_dist, const TsICPPar
  * points in either set or a non-finite/non-positive start. */
 TsICPResult runTsICP(
 	const PointList& ref, const PointList& other, const Similarity2D& start,
+	const TsICPParams& p = {});
+
+/** The same, with the moving set given by a tree built on it beforehand:
+ * refining many hypotheses between the same maps builds it once. */
+TsICPResult runTsICP(
+	const PointList& ref, const PointKDTree& other, const Similarity2D& start,
 	const TsICPParams& p = {});
 
 }  // namespace multires_map_merge

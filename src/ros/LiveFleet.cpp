@@ -255,7 +255,6 @@ void LiveFleet::estimate()
 				PairMemory mem;
 				mem.edge = e;
 				mem.edge.dropped = false;
-				if (!e.aligner_message.empty()) mem.edge.message = e.aligner_message;
 				mem.edge.to = robot_of[e.to], mem.edge.from = robot_of[e.from];
 				mem.to_version = versions[e.to], mem.from_version = versions[e.from];
 				mem.to_known = known_cells[e.to], mem.from_known = known_cells[e.from];
