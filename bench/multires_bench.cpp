@@ -133,7 +133,7 @@ std::shared_ptr<const GridInFrame> mapServerFile(const std::string& log, bool re
 std::ofstream g_candidates;
 const char* kCandidateHeader =
 	"site,ref,other,positive,calibration,index,right,error,scale,overlap,rmse_coarse,consistency,support,"
-	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error\n";
+	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error,screened\n";
 
 /** `error_of(cells)` is the candidate's error (pixels or coarse cells) and
  * whether that is right; for negatives every candidate is wrong. */
@@ -152,7 +152,7 @@ void writeCandidates(
 					 << right << "," << err << "," << c.cells.scale << "," << c.overlap << "," << c.rmse_coarse_cells
 					 << "," << c.consistency << "," << c.support << "," << c.judged_points << ","
 					 << c.tolerant_consistency << "," << c.chance_consistency << "," << c.score << ","
-					 << c.confidence << "," << init.first << "\n";
+					 << c.confidence << "," << init.first << "," << c.screened << "\n";
 	}
 }
 

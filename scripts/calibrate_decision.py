@@ -24,6 +24,11 @@ chance_weight and evidence (the most right merges; ties go to the larger
 chance weight, then the larger evidence) and sets threshold just above the
 highest score any wrong candidate reaches, plus a safety margin, so that no
 calibration candidate that is wrong would be merged. It prints the ini keys.
+
+Rows with screened=1 were dropped by the aligner's cheap verification
+(screen_points): judged on samples under the current decision, at least
+screen_margin below its threshold. They are skipped; to weigh other chance
+weights and evidence fairly, calibrate from a run with screen_points = 0.
 """
 import csv
 import collections
@@ -41,6 +46,8 @@ def load(paths):
         with open(path) as f:
             for r in csv.DictReader(f):
                 if r.get("initial_error") is None or r["calibration"] != "1":
+                    continue
+                if r.get("screened") == "1":
                     continue
                 rows.append({
                     "pair": (r["site"], r["ref"], r["other"]),

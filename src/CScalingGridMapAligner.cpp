@@ -15,6 +15,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,6 +47,8 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_relative_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_coarse_points, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(screen_points, int, c, s);
+	MRPT_LOAD_CONFIG_VAR(screen_margin, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_finish_on_occupied, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_max_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_lattice_step, double, c, s);
@@ -85,6 +88,9 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("icp_max_iterations", icp_max_iterations, 1, 1e5);
 	in("icp_relative_tolerance", icp_relative_tolerance, 0, 1);
 	in("icp_coarse_points", icp_coarse_points, 0, 1e9);
+	if (screen_points != 0)  // 0 turns it off; a screen needs enough points to judge
+		in("screen_points", screen_points, 100, 1e9);
+	in("screen_margin", screen_margin, 0, 10);
 	in("finish_max_shift", finish_max_shift, 0, 100);
 	if (finish_lattice_step != 0)  // 0 turns it off; finer steps only cost time
 		in("finish_lattice_step", finish_lattice_step, 0.01, 0.5);
@@ -119,6 +125,8 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_points, "Each hypothesis is first refined and judged on about this many points (0: off)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_margin, "Dropped there when its score is this far below decision_threshold");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_lattice_step, "Step of the finish's sub-cell shift on the coarser lattice (0: off) [coarse cells]");
@@ -189,11 +197,15 @@ std::string checkGrid(const COccupancyGridMap2D& g)
 // or when the fitted edges sit far apart. A pinned ξ whose pairs fit to a
 // fraction of a cell is no such sign: maps whose edges coincide exactly on
 // part of the overlap make ψ = 0 there, and any larger ξ loses to it.
+// At this edge RMSE (coarse cells) or more the maps are not the same cells:
+// exactConfidence is 0 whatever the cells say.
+constexpr double kExactMaxRmse = 1.5;
+
 double exactConfidence(double consistency, double overlap, double xi_min, double rmse_coarse)
 {
 	const double exact = std::clamp((0.5 - rmse_coarse) / 0.2, 0.0, 1.0);
 	const double pinned = std::max(exact, std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0));
-	const double tight = std::clamp(1.5 - rmse_coarse, 0.0, 1.0);
+	const double tight = std::clamp(kExactMaxRmse - rmse_coarse, 0.0, 1.0);
 	const double agree = std::clamp((consistency - 0.7) / 0.25, 0.0, 1.0);
 	return agree * std::min(pinned, tight);
 }
@@ -291,14 +303,26 @@ Similarity2D finishOnOccupiedCells(
  * partner, so the fixed set should be the map that lies more inside the
  * other (a small map inside a large one): judged at the start transform.
  * The result is always other → ref, in reference cells. */
+/** Every k-th point, about `most` of them (all when fewer). Edge points come
+ * row by row, so a stride samples the whole map. */
+PointList strided(const PointList& points, size_t most)
+{
+	if (most == 0 || points.size() <= most) return points;
+	const size_t stride = points.size() / most;
+	PointList out;
+	out.reserve(points.size() / stride + 1);
+	for (size_t k = 0; k < points.size(); k += stride) out.push_back(points[k]);
+	return out;
+}
+
 TsICPResult refineFromTheInside(
 	const CScalingGridMapAligner::TPreparedMap& ref, const CScalingGridMapAligner::TPreparedMap& other,
-	const Similarity2D& start, const TsICPParams& ip)
+	const Similarity2D& start, const TsICPParams& ip, size_t fixed_points = 0)
 {
 	const double ref_inside = shareOnKnown(ref.edges, start.inverse(), other.field);
 	const double other_inside = shareOnKnown(other.edges, start, ref.field);
-	if (other_inside <= ref_inside) return runTsICP(ref.edges, *other.edge_tree, start, ip);
-	TsICPResult r = runTsICP(other.edges, *ref.edge_tree, start.inverse(), ip);
+	if (other_inside <= ref_inside) return runTsICP(strided(ref.edges, fixed_points), *other.edge_tree, start, ip);
+	TsICPResult r = runTsICP(strided(other.edges, fixed_points), *ref.edge_tree, start.inverse(), ip);
 	const double s2 = 1.0 / (r.transform.scale * r.transform.scale);  // other cells² → ref cells²
 	r.transform = r.transform.inverse();
 	r.trimmed_mse *= s2;
@@ -425,11 +449,69 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TCandidate cand;
 		double icp_s = 0, verify_s = 0;
 	};
+	// The decision's score of a transform, judged on at most `most` points
+	// per map; with fewer than the decision judges, the evidence discount is
+	// taken for the count the decision would judge.
+	auto decisionScore = [&](const Similarity2D& t, size_t most, TwoWaySupport& sup, Chance& chance) {
+		sup = twoWaySupport(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most);
+		chance = chanceSupport(
+			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, options.verify_shift,
+			options.verify_turn_deg, most);
+		auto full = [&](size_t judged, size_t n) {
+			return double(judged) * double(std::min(n, kJudgedPoints)) / double(std::max<size_t>(1, std::min(n, most)));
+		};
+		const double judged = std::min(
+			full(sup.other_in_ref.judged, other_edges.size()), full(sup.ref_in_other.judged, ref_edges.size()));
+		const double tc = sup.consistency();
+		return tc + options.decision_chance_weight * (tc - chance.consistency) -
+			std::sqrt(options.decision_evidence / std::max(1.0, judged));
+	};
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
 		mrpt::system::CTicTac clock;
+		// Cheap first (screen_points): TsICP on a sample of the fixed set,
+		// judged on samples; a hypothesis that cannot come near a merge there
+		// is not refined on every point nor judged in full.
+		if (options.screen_points > 0)
+		{
+			const TsICPResult quick = refineFromTheInside(ref, other, h.other_to_ref, ip, size_t(options.screen_points));
+			out.icp_s = clock.Tac();
+			if (!quick.transform.isFinite() || !(quick.transform.scale > 0)) return out;
+			clock.Tic();
+			TwoWaySupport sup;
+			Chance chance;
+			const double score = decisionScore(quick.transform, size_t(options.screen_points), sup, chance);
+			out.verify_s = clock.Tac();
+			const double rmse_coarse = std::sqrt(quick.trimmed_mse) / std::max(1.0, quick.transform.scale);
+			MRPT_LOG_DEBUG_STREAM(
+				"screen " << h.other_to_ref << " -> " << quick.transform << " rmse " << rmse_coarse << " tolerant consistency "
+						  << sup.consistency() << " chance " << chance.consistency << " score " << score);
+			// Only where neither way to be sure (below) is near: the maps are
+			// not the same cells, and their walls agree too little.
+			if (rmse_coarse >= kExactMaxRmse && score < options.decision_threshold - options.screen_margin)
+			{
+				TCandidate& cand = out.cand;
+				cand.initial_cells = h.other_to_ref;
+				cand.cells = quick.transform;
+				cand.overlap = quick.overlap;
+				cand.rmse_coarse_cells = rmse_coarse;
+				cand.consistency = std::numeric_limits<double>::quiet_NaN();
+				cand.tolerant_consistency = sup.consistency();
+				cand.chance_consistency = chance.consistency;
+				cand.support = sup.score();
+				cand.judged_points = sup.judged();
+				cand.score = score;
+				cand.screened = true;
+				out.r = quick;
+				out.valid = true;
+				return out;
+			}
+			// Refined from where it started, not from the sample's result: the
+			// same local optimum as without the screen.
+			clock.Tic();
+		}
 		const TsICPResult r = refineFromTheInside(ref, other, h.other_to_ref, ip);
-		out.icp_s = clock.Tac();
+		out.icp_s += clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0)) return out;
 		if (expected_scale &&
 			std::abs(std::log(r.transform.scale / *expected_scale)) > std::log1p(options.metadata_scale_tolerance))
@@ -437,34 +519,35 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 
 		// 4. Judge on the cells, against chance (MapAgreement.h).
 		clock.Tic();
-		const Agreement ag = mapAgreement(ref_img, other_img, r.transform);
-		const TwoWaySupport sup =
-			twoWaySupport(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance);
-		const Chance chance = chanceSupport(
-			ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance,
-			options.verify_shift, options.verify_turn_deg);
-		out.verify_s = clock.Tac();
 		const double coarse = std::max(1.0, r.transform.scale);  // coarser cell, in ref cells
 		const double rmse_coarse = std::sqrt(r.trimmed_mse) / coarse;
+		// The strict cell check warps whole maps: spared where it cannot count
+		// (most hypotheses between independent maps).
+		const bool may_be_exact = rmse_coarse < kExactMaxRmse;
+		const double cell_consistency = may_be_exact ? mapAgreement(ref_img, other_img, r.transform).consistency
+													 : std::numeric_limits<double>::quiet_NaN();
+		TwoWaySupport sup;
+		Chance chance;
+		const double score = decisionScore(r.transform, kJudgedPoints, sup, chance);
+		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand.initial_cells = h.other_to_ref;
 		cand.cells = r.transform;
 		cand.overlap = r.overlap;
 		cand.rmse_coarse_cells = rmse_coarse;
-		cand.consistency = ag.consistency;
+		cand.consistency = cell_consistency;
 		cand.tolerant_consistency = sup.consistency();
 		cand.chance_consistency = chance.consistency;
 		cand.support = sup.score();
 		cand.judged_points = sup.judged();
-		cand.score = cand.tolerant_consistency +
-			options.decision_chance_weight * (cand.tolerant_consistency - cand.chance_consistency) -
-			std::sqrt(options.decision_evidence / double(std::max<size_t>(1, cand.judged_points)));
+		cand.score = score;
 		// Two ways to be sure: the maps coincide cell for cell, or (independent
 		// maps) their walls agree within the tolerance well above chance.
 		const double tolerant_conf = cand.judged_points < kMinJudgedPoints
 			? 0.0
 			: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
-		cand.confidence = std::max(exactConfidence(ag.consistency, r.overlap, ip.xi_min, rmse_coarse), tolerant_conf);
+		cand.confidence = std::max(
+			may_be_exact ? exactConfidence(cell_consistency, r.overlap, ip.xi_min, rmse_coarse) : 0.0, tolerant_conf);
 		out.r = r;
 		out.valid = true;
 		return out;

@@ -100,8 +100,7 @@ Support tolerantSupport(
 
 namespace
 {
-// At most this many points per map are judged: the ratio, not the count, matters.
-PointList thinned(const PointList& pts, size_t most = 6000)
+PointList thinned(const PointList& pts, size_t most)
 {
 	if (pts.size() <= most) return pts;
 	PointList out;
@@ -113,23 +112,23 @@ PointList thinned(const PointList& pts, size_t most = 6000)
 
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse)
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most)
 {
 	TwoWaySupport s;
 	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return s;
 	// One coarse cell, in each map's own cells.
 	const double coarse_in_ref = std::max(1.0, other_to_ref.scale);
 	const double coarse_in_other = std::max(1.0, 1.0 / other_to_ref.scale);
-	s.other_in_ref = tolerantSupport(thinned(other_points), other_to_ref, ref_field, tol_coarse * coarse_in_ref);
+	s.other_in_ref = tolerantSupport(thinned(other_points, most), other_to_ref, ref_field, tol_coarse * coarse_in_ref);
 	s.ref_in_other =
-		tolerantSupport(thinned(ref_points), other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other);
+		tolerantSupport(thinned(ref_points, most), other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other);
 	return s;
 }
 
 Chance chanceSupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
 	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, double shift_coarse,
-	double turn_deg)
+	double turn_deg, size_t most)
 {
 	if (other_points.empty() || !other_to_ref.isFinite()) return {};
 	Eigen::Vector2d centre(0, 0);
@@ -150,7 +149,7 @@ Chance chanceSupport(
 	for (const auto& m : moves)
 	{
 		const TwoWaySupport s =
-			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tol_coarse);
+			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tol_coarse, most);
 		best.support = std::max(best.support, s.score());
 		best.consistency = std::max(best.consistency, s.consistency());
 	}

@@ -57,6 +57,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		int icp_max_iterations = 100;
 		double icp_relative_tolerance = 1e-7;
 		int icp_coarse_points = 0;   //!< TsICPParams::coarse_points
+		/** Cheap verification before the expensive one: each hypothesis is
+		 * first refined by TsICP on about this many points of the fixed map
+		 * and judged on as many per map; unless the maps could be the same
+		 * cells there (edge RMSE < 1.5 coarse cells), one whose decision score
+		 * is more than `screen_margin` below `decision_threshold` is dropped
+		 * (TCandidate::screened) instead of refined on every point. 0: off. */
+		int screen_points = 1500;
+		double screen_margin = 0.15;
 		/** The decided transform is refined once more by TsICP on every
 		 * occupied cell of both maps (EdgePoints.h, occupiedPoints): edges
 		 * are staircases that differ between resolutions and rotations. The
@@ -116,7 +124,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	{
 		Similarity2D initial_cells, cells;  //!< RANSAC start, TsICP result (cell coordinates)
 		double overlap = 0, rmse_coarse_cells = 0;
-		double consistency = 0;  //!< strict cell consistency (MapAgreement), for reference
+		/** Strict cell consistency (MapAgreement); NaN where the edge RMSE
+		 * (≥ 1.5 coarse cells) already says the maps are not the same cells. */
+		double consistency = 0;
 		/** Tolerant consistency of both maps' wall points (MapAgreement.h,
 		 * twoWaySupport) and the best of it under far perturbations of the
 		 * same transform: what chance gives in these two maps. */
@@ -126,6 +136,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
 		double confidence = 0;
+		/** Dropped by the cheap verification (screen_points): the numbers are
+		 * those of the sample, not refined further. */
+		bool screened = false;
 	};
 
 	struct TReturnInfo : public mrpt::slam::TMetricMapAlignmentResult

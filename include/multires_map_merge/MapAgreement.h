@@ -68,6 +68,10 @@ Support tolerantSupport(
 	const PointList& points, const Similarity2D& source_to_target, const OccupancyField& target,
 	double tolerance);
 
+/** Wall points judged per map at most (evenly thinned): the ratios, not the
+ * counts, matter. A screen judges fewer. */
+constexpr size_t kJudgedPoints = 6000;
+
 /** Both ways, for a transform between two maps' cells. */
 struct TwoWaySupport
 {
@@ -86,7 +90,8 @@ struct TwoWaySupport
 
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells);
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	size_t most_points = kJudgedPoints);
 
 /** The best two-way score under "far" perturbations of the transform: the
  * other map shifted by ±`shift_coarse_cells` along each axis and turned by
@@ -99,6 +104,6 @@ struct Chance
 Chance chanceSupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
 	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
-	double shift_coarse_cells, double turn_deg);
+	double shift_coarse_cells, double turn_deg, size_t most_points = kJudgedPoints);
 
 }  // namespace multires_map_merge
