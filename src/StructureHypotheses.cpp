@@ -54,7 +54,8 @@ double dominantWallDirection(const cv::Mat& classes)
 	cv::Sobel(walls, gx, CV_32F, 1, 0);
 	cv::Sobel(walls, gy, CV_32F, 0, 1);
 	// Directions modulo 90° as angles 4θ on a circle: the weighted circular
-	// mean is the dominant direction of walls at right angles.
+	// mean is the dominant direction of walls at right angles. With the
+	// gradient as z = a + ib, m²·e^{i4θ} = z⁴ / |z|²: no trigonometry per cell.
 	double c = 0, s = 0;
 	for (int y = 0; y < walls.rows; ++y)
 		for (int x = 0; x < walls.cols; ++x)
@@ -62,8 +63,8 @@ double dominantWallDirection(const cv::Mat& classes)
 			const double a = gx.at<float>(y, x), b = gy.at<float>(y, x);
 			const double m2 = a * a + b * b;
 			if (m2 < 1e-8) continue;
-			const double t4 = 4 * std::atan2(b, a);
-			c += m2 * std::cos(t4), s += m2 * std::sin(t4);
+			const double a2 = a * a, b2 = b * b;
+			c += (a2 * a2 - 6 * a2 * b2 + b2 * b2) / m2, s += 4 * a * b * (a2 - b2) / m2;
 		}
 	double d = std::atan2(s, c) / 4;
 	if (d < 0) d += M_PI / 2;
@@ -92,8 +93,20 @@ std::vector<Hypothesis> structureHypotheses(
 				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
 	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
 
-	const Similarity2D other_down = resampling(f_other), ref_up = resampling(f_ref).inverse();
-	std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra_of_a;  // a and a², by canvas size
+	const Similarity2D other_down = resampling(f_other);
+	// Where the other map would be enlarged (scale above one), the reference
+	// is shrunk instead: the canvas, and with it the DFTs, stay about twice
+	// the working size instead of growing with the scale (most of the time
+	// went there), at the same resolution of the other map's cells.
+	struct RefView
+	{
+		double f = 0;  //!< ref full cells → this image
+		cv::Mat walls;
+		std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra;  //!< walls and walls², by canvas size
+	};
+	std::map<double, RefView> ref_views;  // by factor
+	ref_views[f_ref].f = f_ref;
+	ref_views[f_ref].walls = a;
 	std::mutex spectra_mutex;
 	// The poses (scale × right-angle turn) are independent: searched in
 	// parallel, each keeping its own peaks, gathered in pose order so the
@@ -106,13 +119,24 @@ std::vector<Hypothesis> structureHypotheses(
 			const int k = pose % 4;
 			std::vector<Scored>& found = found_per_pose[pose];
 			// Other's working image → ref's working image, up to a translation.
-			const Similarity2D lin(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0});
-			Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
-			for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b0.cols, 0),
-											 Eigen::Vector2d(0, b0.rows), Eigen::Vector2d(b0.cols, b0.rows)})
-				lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
+			auto placedSize = [&](const Similarity2D& lin) {
+				Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
+				for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b0.cols, 0),
+												 Eigen::Vector2d(0, b0.rows), Eigen::Vector2d(b0.cols, b0.rows)})
+					lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
+				return std::pair{lo, hi};
+			};
+			{
+				// The poses searched: those whose other map fits three working
+				// sizes at the reference's working size (as before the shrink).
+				const auto [lo, hi] = placedSize(Similarity2D(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0}));
+				if (hi.x() - lo.x() + 1 > 3 * p.working_size || hi.y() - lo.y() + 1 > 3 * p.working_size) continue;
+			}
+			const double f_view = f_ref * std::min(1.0, f_other / (s * f_ref));
+			const Similarity2D lin(s * f_view / f_other, turn + k * M_PI / 2, {0, 0});
+			const auto [lo, hi] = placedSize(lin);
 			const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
-			if (bw > 3 * p.working_size || bh > 3 * p.working_size || bw < 8 || bh < 8) continue;
+			if (bw < 8 || bh < 8) continue;
 			const Similarity2D place(lin.scale, lin.yaw, -lo);  // into a bw × bh image
 			const Eigen::Matrix2d l = place.linear();
 			const cv::Mat m = (cv::Mat_<double>(2, 3) << l(0, 0), l(0, 1), place.t.x(), l(1, 0), l(1, 1), place.t.y());
@@ -125,6 +149,14 @@ std::vector<Hypothesis> structureHypotheses(
 			// energy of both where they overlap (masked normalised cross-
 			// correlation): a shrunken, dense copy of the other map must not
 			// win by touching many walls.
+			RefView* view;
+			{
+				std::lock_guard<std::mutex> lock(spectra_mutex);
+				view = &ref_views[f_view];
+				if (view->walls.empty()) view->f = f_view, view->walls = wallImage(ref_classes, f_view);
+			}
+			const cv::Mat& a = view->walls;
+			if (cv::sum(a)[0] <= 0) continue;
 			const int w = cv::getOptimalDFTSize(a.cols + bw), h = cv::getOptimalDFTSize(a.rows + bh);
 			auto spectrum = [&](const cv::Mat& img) {
 				cv::Mat pad = cv::Mat::zeros(h, w, CV_32F), f;
@@ -141,7 +173,7 @@ std::vector<Hypothesis> structureHypotheses(
 			cv::Mat fa, fa2;
 			{
 				std::lock_guard<std::mutex> lock(spectra_mutex);
-				auto& cached = spectra_of_a[{w, h}];
+				auto& cached = view->spectra[{w, h}];
 				if (cached.first.empty()) cached = {spectrum(a), spectrum(a.mul(a))};
 				fa = cached.first, fa2 = cached.second;
 			}
@@ -161,7 +193,7 @@ std::vector<Hypothesis> structureHypotheses(
 				// Shifts past the middle are negative (the FFT wraps).
 				const double dx = at.x > w - bw ? at.x - w : at.x, dy = at.y > h - bh ? at.y - h : at.y;
 				const Similarity2D working(place.scale, place.yaw, place.t + Eigen::Vector2d(dx, dy));
-				found.push_back({ref_up.compose(working).compose(other_down), best});
+				found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
 				cv::circle(corr, at, 6, cv::Scalar(0), cv::FILLED);
 			}
 		}
