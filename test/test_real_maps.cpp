@@ -102,6 +102,47 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 	EXPECT_FALSE(res.success) << "confidence " << res.confidence;
 }
 
+TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
+{
+	REQUIRE_HALMSTAD();
+	// The cheap verification (screen_points) must change what is computed,
+	// not what is decided: a merged pair gives the same transform and
+	// confidence with and without it, and a refused pair stays refused with
+	// every dropped candidate scored well below the threshold.
+	CScalingGridMapAligner screened, full;
+	full.options.screen_points = 0;
+	ASSERT_GT(screened.options.screen_points, 0);
+	auto load = [&](const std::string& map) { return loadGridMap(halmstad()->yaml(map, dir())); };
+	{
+		const GridInFrame r = load("E5_02"), o = load("E5_01");
+		const auto a = screened.alignScaled(r, o), b = full.alignScaled(r, o);
+		ASSERT_TRUE(a.success) << a.message;
+		ASSERT_TRUE(b.success) << b.message;
+		EXPECT_NEAR(a.confidence, b.confidence, 1e-9);
+		EXPECT_NEAR(a.metric.t.x(), b.metric.t.x(), 1e-6);
+		EXPECT_NEAR(a.metric.t.y(), b.metric.t.y(), 1e-6);
+		EXPECT_NEAR(a.metric.yaw, b.metric.yaw, 1e-9);
+		EXPECT_NEAR(a.metric.scale, b.metric.scale, 1e-9);
+	}
+	{
+		const GridInFrame r = load("E5_03"), o = load("E5_01");
+		const auto a = screened.alignScaled(r, o), b = full.alignScaled(r, o);
+		EXPECT_FALSE(a.success);
+		EXPECT_FALSE(b.success);
+		size_t dropped = 0;
+		for (const auto& c : a.candidates)
+			if (c.screened)
+			{
+				++dropped;
+				EXPECT_LT(c.score, screened.options.decision_threshold - screened.options.screen_margin);
+				EXPECT_EQ(c.confidence, 0);
+			}
+		EXPECT_GT(dropped, 0u) << "nothing screened on a refused pair";
+		EXPECT_EQ(a.candidates.size(), b.candidates.size());
+		for (const auto& c : b.candidates) EXPECT_FALSE(c.screened);
+	}
+}
+
 // The Willow Garage pair: navstage 5 cm against stageros 10 cm, two
 // independent SLAM runs of the building, one turned about 90°. There is no
 // annotated truth (SOURCES.md); the reference below was established by
