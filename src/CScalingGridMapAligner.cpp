@@ -299,10 +299,6 @@ Similarity2D finishOnOccupiedCells(
 	return t.isFinite() && t.scale > 0 ? t : cells;
 }
 
-/** TsICP trims to the share ξ ≥ ξmin of its fixed set's points that find a
- * partner, so the fixed set should be the map that lies more inside the
- * other (a small map inside a large one): judged at the start transform.
- * The result is always other → ref, in reference cells. */
 /** Every k-th point, about `most` of them (all when fewer). Edge points come
  * row by row, so a stride samples the whole map. */
 PointList strided(const PointList& points, size_t most)
@@ -315,6 +311,10 @@ PointList strided(const PointList& points, size_t most)
 	return out;
 }
 
+/** TsICP trims to the share ξ ≥ ξmin of its fixed set's points that find a
+ * partner, so the fixed set should be the map that lies more inside the
+ * other (a small map inside a large one): judged at the start transform.
+ * The result is always other → ref, in reference cells. */
 TsICPResult refineFromTheInside(
 	const CScalingGridMapAligner::TPreparedMap& ref, const CScalingGridMapAligner::TPreparedMap& other,
 	const Similarity2D& start, const TsICPParams& ip, size_t fixed_points = 0)
@@ -466,6 +466,11 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return tc + options.decision_chance_weight * (tc - chance.consistency) -
 			std::sqrt(options.decision_evidence / std::max(1.0, judged));
 	};
+	// With use_resolution_metadata, a refinement that leaves the stated scale is no candidate.
+	auto scaleAsStated = [&](const Similarity2D& t) {
+		return !expected_scale ||
+			std::abs(std::log(t.scale / *expected_scale)) <= std::log1p(options.metadata_scale_tolerance);
+	};
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
 		mrpt::system::CTicTac clock;
@@ -476,7 +481,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		{
 			const TsICPResult quick = refineFromTheInside(ref, other, h.other_to_ref, ip, size_t(options.screen_points));
 			out.icp_s = clock.Tac();
-			if (!quick.transform.isFinite() || !(quick.transform.scale > 0)) return out;
+			if (!quick.transform.isFinite() || !(quick.transform.scale > 0) || !scaleAsStated(quick.transform))
+				return out;
 			clock.Tic();
 			TwoWaySupport sup;
 			Chance chance;
@@ -512,10 +518,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		}
 		const TsICPResult r = refineFromTheInside(ref, other, h.other_to_ref, ip);
 		out.icp_s += clock.Tac();
-		if (!r.transform.isFinite() || !(r.transform.scale > 0)) return out;
-		if (expected_scale &&
-			std::abs(std::log(r.transform.scale / *expected_scale)) > std::log1p(options.metadata_scale_tolerance))
-			return out;
+		if (!r.transform.isFinite() || !(r.transform.scale > 0) || !scaleAsStated(r.transform)) return out;
 
 		// 4. Judge on the cells, against chance (MapAgreement.h).
 		clock.Tic();
