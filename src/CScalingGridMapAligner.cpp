@@ -299,18 +299,6 @@ Similarity2D finishOnOccupiedCells(
 	return t.isFinite() && t.scale > 0 ? t : cells;
 }
 
-/** Every k-th point, about `most` of them (all when fewer). Edge points come
- * row by row, so a stride samples the whole map. */
-PointList strided(const PointList& points, size_t most)
-{
-	if (most == 0 || points.size() <= most) return points;
-	const size_t stride = points.size() / most;
-	PointList out;
-	out.reserve(points.size() / stride + 1);
-	for (size_t k = 0; k < points.size(); k += stride) out.push_back(points[k]);
-	return out;
-}
-
 /** TsICP trims to the share ξ ≥ ξmin of its fixed set's points that find a
  * partner, so the fixed set should be the map that lies more inside the
  * other (a small map inside a large one): judged at the start transform.
@@ -321,8 +309,13 @@ TsICPResult refineFromTheInside(
 {
 	const double ref_inside = shareOnKnown(ref.edges, start.inverse(), other.field);
 	const double other_inside = shareOnKnown(other.edges, start, ref.field);
-	if (other_inside <= ref_inside) return runTsICP(strided(ref.edges, fixed_points), *other.edge_tree, start, ip);
-	TsICPResult r = runTsICP(strided(other.edges, fixed_points), *ref.edge_tree, start.inverse(), ip);
+	// Sampled only when asked: the fixed set is otherwise used in place, not copied.
+	auto run = [&](const PointList& fixed, const PointKDTree& moving, const Similarity2D& from) {
+		return fixed_points > 0 && fixed.size() > fixed_points ? runTsICP(strided(fixed, fixed_points), moving, from, ip)
+															   : runTsICP(fixed, moving, from, ip);
+	};
+	if (other_inside <= ref_inside) return run(ref.edges, *other.edge_tree, start);
+	TsICPResult r = run(other.edges, *ref.edge_tree, start.inverse());
 	const double s2 = 1.0 / (r.transform.scale * r.transform.scale);  // other cells² → ref cells²
 	r.transform = r.transform.inverse();
 	r.trimmed_mse *= s2;
@@ -466,6 +459,21 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return tc + options.decision_chance_weight * (tc - chance.consistency) -
 			std::sqrt(options.decision_evidence / std::max(1.0, judged));
 	};
+	auto candidate = [](const Hypothesis& h, const TsICPResult& r, double rmse_coarse, double cell_consistency,
+						const TwoWaySupport& sup, const Chance& chance, double score) {
+		TCandidate c;
+		c.initial_cells = h.other_to_ref;
+		c.cells = r.transform;
+		c.overlap = r.overlap;
+		c.rmse_coarse_cells = rmse_coarse;
+		c.consistency = cell_consistency;
+		c.tolerant_consistency = sup.consistency();
+		c.chance_consistency = chance.consistency;
+		c.support = sup.score();
+		c.judged_points = sup.judged();
+		c.score = score;
+		return c;
+	};
 	// With use_resolution_metadata, a refinement that leaves the stated scale is no candidate.
 	auto scaleAsStated = [&](const Similarity2D& t) {
 		return !expected_scale ||
@@ -496,18 +504,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			// not the same cells, and their walls agree too little.
 			if (rmse_coarse >= kExactMaxRmse && score < options.decision_threshold - options.screen_margin)
 			{
-				TCandidate& cand = out.cand;
-				cand.initial_cells = h.other_to_ref;
-				cand.cells = quick.transform;
-				cand.overlap = quick.overlap;
-				cand.rmse_coarse_cells = rmse_coarse;
-				cand.consistency = std::numeric_limits<double>::quiet_NaN();
-				cand.tolerant_consistency = sup.consistency();
-				cand.chance_consistency = chance.consistency;
-				cand.support = sup.score();
-				cand.judged_points = sup.judged();
-				cand.score = score;
-				cand.screened = true;
+				out.cand = candidate(h, quick, rmse_coarse, std::numeric_limits<double>::quiet_NaN(), sup, chance, score);
+				out.cand.screened = true;
 				out.r = quick;
 				out.valid = true;
 				return out;
@@ -534,16 +532,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		const double score = decisionScore(r.transform, kJudgedPoints, sup, chance);
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
-		cand.initial_cells = h.other_to_ref;
-		cand.cells = r.transform;
-		cand.overlap = r.overlap;
-		cand.rmse_coarse_cells = rmse_coarse;
-		cand.consistency = cell_consistency;
-		cand.tolerant_consistency = sup.consistency();
-		cand.chance_consistency = chance.consistency;
-		cand.support = sup.score();
-		cand.judged_points = sup.judged();
-		cand.score = score;
+		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
 		// Two ways to be sure: the maps coincide cell for cell, or (independent
 		// maps) their walls agree within the tolerance well above chance.
 		const double tolerant_conf = cand.judged_points < kMinJudgedPoints

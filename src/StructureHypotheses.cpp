@@ -102,11 +102,13 @@ std::vector<Hypothesis> structureHypotheses(
 	{
 		double f = 0;  //!< ref full cells → this image
 		cv::Mat walls;
+		bool has_walls = false;  //!< any wall left at this size
 		std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra;  //!< walls and walls², by canvas size
 	};
 	std::map<double, RefView> ref_views;  // by factor
 	ref_views[f_ref].f = f_ref;
 	ref_views[f_ref].walls = a;
+	ref_views[f_ref].has_walls = true;  // checked above
 	std::mutex spectra_mutex;
 	// The poses (scale × right-angle turn) are independent: searched in
 	// parallel, each keeping its own peaks, gathered in pose order so the
@@ -153,10 +155,14 @@ std::vector<Hypothesis> structureHypotheses(
 			{
 				std::lock_guard<std::mutex> lock(spectra_mutex);
 				view = &ref_views[f_view];
-				if (view->walls.empty()) view->f = f_view, view->walls = wallImage(ref_classes, f_view);
+				if (view->walls.empty())
+				{
+					view->f = f_view, view->walls = wallImage(ref_classes, f_view);
+					view->has_walls = cv::sum(view->walls)[0] > 0;
+				}
 			}
 			const cv::Mat& a = view->walls;
-			if (cv::sum(a)[0] <= 0) continue;
+			if (!view->has_walls) continue;
 			const int w = cv::getOptimalDFTSize(a.cols + bw), h = cv::getOptimalDFTSize(a.rows + bh);
 			auto spectrum = [&](const cv::Mat& img) {
 				cv::Mat pad = cv::Mat::zeros(h, w, CV_32F), f;

@@ -128,6 +128,16 @@ TsICPResult iterate(
 }
 }  // namespace
 
+PointList strided(const PointList& points, size_t most)
+{
+	if (most == 0 || points.size() <= most) return points;
+	const size_t stride = points.size() / most;
+	PointList out;
+	out.reserve(points.size() / stride + 1);
+	for (size_t k = 0; k < points.size(); k += stride) out.push_back(points[k]);
+	return out;
+}
+
 TsICPResult runTsICP(
 	const PointList& ref, const PointList& other, const Similarity2D& start,
 	const TsICPParams& p)
@@ -152,12 +162,8 @@ TsICPResult runTsICP(
 	if (p.coarse_points <= 0 || ref.size() <= 2 * size_t(p.coarse_points))
 		return iterate(ref, other, other_tree, start, p, p.max_iterations);
 
-	// Coarse: every k-th reference point (edge points come row by row, so a
-	// stride samples the whole map).
-	const size_t stride = ref.size() / size_t(p.coarse_points);
-	PointList sample;
-	sample.reserve(ref.size() / stride + 1);
-	for (size_t k = 0; k < ref.size(); k += stride) sample.push_back(ref[k]);
+	// Coarse: every k-th reference point.
+	const PointList sample = strided(ref, size_t(p.coarse_points));
 	const TsICPResult coarse = iterate(sample, other, other_tree, start, p, p.max_iterations);
 	// Fine: on all points, from the coarse result unless (rarely) it is worse
 	// there than the start.

@@ -54,6 +54,10 @@ struct Trimming
 /** Picks ξ ∈ [xi_min, 1] minimising ψ over squared distances sorted ascending. */
 Trimming chooseOverlap(const std::vector<double>& sorted_sq_dist, const TsICPParams& p);
 
+/** Every k-th point, about `most` of them (all when fewer or `most` is 0).
+ * Edge points come row by row, so a stride samples the whole map. */
+PointList strided(const PointList& points, size_t most);
+
 /** Runs TsICP from `start`. Throws std::invalid_argument on fewer than 3
  * points in either set or a non-finite/non-positive start. */
 TsICPResult runTsICP(

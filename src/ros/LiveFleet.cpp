@@ -12,6 +12,14 @@
 
 namespace multires_map_merge::ros1
 {
+namespace
+{
+size_t knownCells(const nav_msgs::OccupancyGrid& msg)
+{
+	return size_t(std::count_if(msg.data.begin(), msg.data.end(), [](int8_t v) { return v >= 0; }));
+}
+}  // namespace
+
 LiveFleet::LiveFleet(const LiveFleetParams& params) : params_(params)
 {
 	if (const std::string why = params_.aligner.invalidReason(); !why.empty())
@@ -78,7 +86,7 @@ std::string LiveFleet::onMap(const std::string& robot, const nav_msgs::Occupancy
 	if (same) return "";
 	++r->map_version;
 	r->grid = std::move(grid), r->converted_version = r->map_version;
-	r->known_cells = size_t(std::count_if(msg.data.begin(), msg.data.end(), [](int8_t v) { return v >= 0; }));
+	r->known_cells = knownCells(msg);
 	++version_;
 	if (world_robot_.empty() && !params_.known_init_poses) world_robot_ = robot;
 	return "";
@@ -119,7 +127,7 @@ const GridInFrame& LiveFleet::converted(Robot& r)
 	if (r.converted_version != r.map_version)
 	{
 		r.grid = std::make_shared<const GridInFrame>(gridFromMsg(*r.map, r.name));  // validated on arrival
-		r.known_cells = size_t(std::count_if(r.map->data.begin(), r.map->data.end(), [](int8_t v) { return v >= 0; }));
+		r.known_cells = knownCells(*r.map);
 		r.converted_version = r.map_version;
 	}
 	return *r.grid;
