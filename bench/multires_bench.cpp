@@ -133,7 +133,19 @@ std::shared_ptr<const GridInFrame> mapServerFile(const std::string& log, bool re
 std::ofstream g_candidates;
 const char* kCandidateHeader =
 	"site,ref,other,positive,calibration,index,right,error,scale,overlap,rmse_coarse,consistency,support,"
-	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error,screened\n";
+	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error,screened,yaw_deg,centre_x,"
+	"centre_y\n";
+
+/** The options every aligner of the benchmark runs with: the defaults, except
+ * for --calibration-data, which refines every hypothesis and always searches
+ * the structure (no decision cuts the candidate lists short). */
+CScalingGridMapAligner::TConfigParams g_aligner_options;
+CScalingGridMapAligner benchAligner()
+{
+	CScalingGridMapAligner a;
+	a.options = g_aligner_options;
+	return a;
+}
 
 /** `error_of(cells)` is the candidate's error (pixels or coarse cells) and
  * whether that is right; for negatives every candidate is wrong. */
@@ -152,7 +164,8 @@ void writeCandidates(
 					 << right << "," << err << "," << c.cells.scale << "," << c.overlap << "," << c.rmse_coarse_cells
 					 << "," << c.consistency << "," << c.support << "," << c.judged_points << ","
 					 << c.tolerant_consistency << "," << c.chance_consistency << "," << c.score << ","
-					 << c.confidence << "," << init.first << "," << c.screened << "\n";
+					 << c.confidence << "," << init.first << "," << c.screened << "," << c.cells.yaw * 180 / M_PI << ","
+					 << c.other_centre.x() << "," << c.other_centre.y() << "\n";
 	}
 }
 
@@ -220,7 +233,7 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 	const double coarse = std::max(rr, ro);
 	const PointList other_edges = metricEdges(other);
 
-	CScalingGridMapAligner aligner;
+	CScalingGridMapAligner aligner = benchAligner();
 	mrpt::system::CTicTac clock;
 	const auto r = aligner.alignScaled(ref, other);  // between the maps' frames
 	p.seconds = clock.Tac();
@@ -333,7 +346,7 @@ double peakRssMb()
 int scalingChild(const std::string& ref_path, const std::string& other_path)
 {
 	const auto ref = loadGridMap(ref_path), other = loadGridMap(other_path);
-	CScalingGridMapAligner aligner;
+	CScalingGridMapAligner aligner = benchAligner();
 	mrpt::system::CTicTac clock;
 	const auto r = aligner.alignScaled(ref, other);
 	const double seconds = clock.Tac();
@@ -534,7 +547,7 @@ int fleetChild(const std::string& dir)
 	for (int i = 0; fs::exists(dir + "/map_" + std::to_string(i) + ".yaml"); ++i)
 		maps.push_back(loadGridMap(dir + "/map_" + std::to_string(i) + ".yaml"));
 	mrpt::system::CTicTac clock;
-	const FleetResult r = placeFleet(maps, 0, CScalingGridMapAligner());
+	const FleetResult r = placeFleet(maps, 0, benchAligner());
 	const double placing = clock.Tac();
 	const FusedFleet fused = fuseFleet(maps, r, 0, maps[0].grid.getResolution());
 	const double seconds = clock.Tac();
@@ -765,7 +778,7 @@ std::vector<Negative> runCarmenNegatives(bool quick)
 		const ScanSequence& sb = scansOf(b);
 		const auto ga = renderGrid(sa, 0, sa.size(), 0.05);
 		const auto gb = renderGrid(sb, 0, sb.size(), 0.08);
-		const auto r = CScalingGridMapAligner().alignScaled(ga, gb);
+		const auto r = benchAligner().alignScaled(ga, gb);
 		writeCandidates("carmen", a, b, false, true, r, noTruth);
 		negatives.push_back({a, b, "different buildings", r.success, r.confidence, r.message});
 		std::cout << "negative " << a << " vs " << b << ": " << (r.success ? "MERGED (false merge)" : "refused")
@@ -790,7 +803,7 @@ std::vector<Negative> runCarmenNegatives(bool quick)
 			}
 		return c;
 		};
-		const auto r = CScalingGridMapAligner().alignScaled(crop(whole5, 0, 0.4), crop(whole8, 0.6, 1));
+		const auto r = benchAligner().alignScaled(crop(whole5, 0, 0.4), crop(whole8, 0.6, 1));
 		writeCandidates("carmen", log + "_west", log + "_east", false, true, r, noTruth);
 		negatives.push_back({log + " west", log + " east", "disjoint parts of one run", r.success, r.confidence, r.message});
 		std::cout << "negative " << log << " disjoint halves: " << (r.success ? "MERGED (false merge)" : "refused")
@@ -816,7 +829,7 @@ void runExtraCalibrationNegatives(const HalmstadData& data)
 			const GridInFrame orig = loadGridMap(data.yaml(m, dir));
 			cv::imwrite(dir + "/mirror.png", mirrored);
 			std::ofstream(dir + "/mirror.yaml") << "image: mirror.png\nresolution: 0.05\norigin: [0, 0, 0]\n";
-			const auto r = CScalingGridMapAligner().alignScaled(orig, loadGridMap(dir + "/mirror.yaml"));
+			const auto r = benchAligner().alignScaled(orig, loadGridMap(dir + "/mirror.yaml"));
 			writeCandidates("mirror", m, m + "_mirrored", false, true, r, noTruth);
 			std::cout << "negative " << m << " vs its mirror image: " << (r.success ? "MERGED (false)" : "refused") << std::endl;
 		}
@@ -827,7 +840,7 @@ void runExtraCalibrationNegatives(const HalmstadData& data)
 			{
 				const ScanSequence& sa = scansOf(kLogs[i].name);
 				const ScanSequence& sb = scansOf(kLogs[j].name);
-				const auto r = CScalingGridMapAligner().alignScaled(
+				const auto r = benchAligner().alignScaled(
 					renderGrid(sa, 0, sa.size(), 0.08), renderGrid(sb, 0, sb.size(), 0.05));
 				writeCandidates("carmen", kLogs[i].name + "_8cm", kLogs[j].name + "_5cm", false, true, r, noTruth);
 				std::cout << "negative " << kLogs[i].name << " 8 cm vs " << kLogs[j].name << " 5 cm: "
@@ -865,7 +878,7 @@ HalmstadRun runHalmstadPair(
 	const GridInFrame ref_map = loadGridMap(data.yaml(ref, dir)), other_map = loadGridMap(data.yaml(other, dir));
 	const HalmstadPair* truth = run.positive ? data.pair(other, ref) : nullptr;
 	mrpt::system::CTicTac clock;
-	const auto r = CScalingGridMapAligner().alignScaled(ref_map, other_map);
+	const auto r = benchAligner().alignScaled(ref_map, other_map);
 	run.seconds = clock.Tac();
 	run.merged = r.success;
 	run.confidence = r.confidence;
@@ -1019,6 +1032,10 @@ int main(int argc, char** argv)
 		g_candidates << kCandidateHeader;
 		if (calibration_arg.getValue())
 		{
+			// Every hypothesis refined, the structure always searched: the
+			// decision is fitted on the candidates it sees when it runs (the
+			// screen's included), of every pair, not on those a decision kept.
+			g_aligner_options.exhaustive_search = true;
 			const HalmstadData data(g_data + "/halmstad");
 			if (!extra_arg.getValue())
 			{
@@ -1100,7 +1117,7 @@ int main(int argc, char** argv)
 		CScalingGridMapAligner::TReturnInfo willow;
 		{
 			const std::string w = g_data + "/ros_maps/willow/";
-			willow = CScalingGridMapAligner().alignScaled(
+			willow = benchAligner().alignScaled(
 				loadGridMap(w + "navstage_willow_5cm.yaml"), loadGridMap(w + "stageros_willow_10cm.yaml"));
 		}
 

@@ -11,7 +11,7 @@ different-building and disjoint-part pairs at both resolution orders, and
 every E5 and HIH map against its own mirror image (negatives). F5 and KPT4A rows are
 the acceptance set and are never read here.
 
-The decision (src/CScalingGridMapAligner.cpp) scores a refined candidate by
+The decision (src/CScalingGridMapAligner.cpp) scores each refined candidate by
     score = T + chance_weight * (T - C) - sqrt(evidence / n)
 where T is the tolerant consistency (share of both maps' wall points moved
 onto seen space that do not land on clearly free space), C the best T under
@@ -19,25 +19,42 @@ far perturbations of the transform (what chance gives in these maps), and n
 the number of wall points judged (the weaker direction): neighbouring wall
 points are far from independent, so a T measured on a small overlap (a map
 shrunk into a corner of the other) is discounted like a proportion from few
-samples. The candidate is merged when score >= threshold. This script picks
-chance_weight and evidence (the most right merges; ties go to the larger
-chance weight, then the larger evidence) and sets threshold just above the
-highest score any wrong candidate reaches, plus a safety margin, so that no
-calibration candidate that is wrong would be merged. It prints the ini keys.
+samples. The pair is then decided on its best-scoring candidate by
+    value = score + runner_up_weight * (score - max(floor, rival))
+where rival is the best score of a candidate that puts the other map
+elsewhere (its wall centroid more than distinct_shift coarse cells away,
+turned by more than verify_turn_deg, or scaled by more than 10 %): the right
+alignment of one building stands out, a chance fit between two buildings has
+rivals nearly as good. The pair is merged when value >= threshold.
 
-Rows with screened=1 were dropped by the aligner's cheap verification
-(screen_points): judged on samples under the current decision, at least
-screen_margin below its threshold. They are skipped; to weigh other chance
-weights and evidence fairly, calibrate from a run with screen_points = 0.
+This script picks chance_weight, evidence, runner_up_weight and floor (the
+most right merges; ties go to the smaller runner-up weight, then the larger
+chance weight and evidence) and sets threshold just above the highest value
+any pair whose best candidate is wrong reaches, plus a safety margin, so that
+no calibration pair would be merged wrong. It prints the ini keys.
+
+The data comes from `multires_bench --calibration-data`: the aligner as it
+runs (the screen on), with exhaustive_search so that every hypothesis is
+refined and the structure always searched. Rows with screened=1 were dropped
+by the screen (scored on a sample, below the lowest score that can merge
+less screen_margin, which is about the floor): as in the aligner, they are
+neither a pair's best nor anyone's rival. The screen's bar follows from the
+decision (lowestMergeableScore): after changing the defaults, regenerate the
+data and check that the fit stays.
 """
 import csv
 import collections
 import math
 import sys
 
-MARGIN = 0.02  # safety margin above the highest wrong score
-WEIGHTS = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0]
-EVIDENCE = [0, 10, 25, 50, 100, 200, 400]
+MARGIN = 0.02  # safety margin above the highest wrong value
+WEIGHTS = [0.5, 1.0, 1.5]
+EVIDENCE = [200, 400, 1000]
+RUNNER_UP = [0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0]
+FLOORS = [-0.5, 0.0, 0.25]
+DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
+TURN_DEG = 8.0  # the aligner's verify_turn_deg
+MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
 
 
 def load(paths):
@@ -45,19 +62,29 @@ def load(paths):
     for path in paths:
         with open(path) as f:
             for r in csv.DictReader(f):
-                if r.get("initial_error") is None or r["calibration"] != "1":
-                    continue
-                if r.get("screened") == "1":
+                if r.get("centre_x") is None or r["calibration"] != "1":
                     continue
                 rows.append({
                     "pair": (r["site"], r["ref"], r["other"]),
                     "positive": r["positive"] == "1",
                     "right": r["right"] == "1",
+                    "screened": r.get("screened") == "1",
                     "T": float(r["tolerant_consistency"]),
                     "C": float(r["chance_consistency"]),
                     "n": max(1, int(r["judged"])),
+                    "scale": float(r["scale"]),
+                    "yaw": math.radians(float(r["yaw_deg"])),
+                    "centre": (float(r["centre_x"]), float(r["centre_y"])),
                 })
     return rows
+
+
+def distinct(a, b):
+    coarse = max(1.0, a["scale"], b["scale"])
+    turn = abs(math.remainder(a["yaw"] - b["yaw"], 2 * math.pi))
+    shift = math.hypot(a["centre"][0] - b["centre"][0], a["centre"][1] - b["centre"][1])
+    return (shift > DISTINCT_SHIFT * coarse or turn > math.radians(TURN_DEG)
+            or abs(math.log(a["scale"] / b["scale"])) > math.log(1.1))
 
 
 def main():
@@ -67,28 +94,47 @@ def main():
     pairs = collections.defaultdict(list)
     for r in rows:
         pairs[r["pair"]].append(r)
+    # Which candidates are rivals of which does not depend on the weights.
+    rivals = {id(r): [o for o in c if o is not r and not o["screened"] and distinct(r, o)]
+              for c in pairs.values() for r in c}
     positives = [k for k, c in pairs.items() if c[0]["positive"]]
     reachable = [k for k in positives if any(x["right"] for x in pairs[k])]
     print(f"calibration data: {len(rows)} candidates, {len(positives)} positive pairs "
           f"({len(reachable)} with a right candidate), {len(pairs) - len(positives)} negative pairs")
     best = None
     for w in WEIGHTS:
-        for k in EVIDENCE:
+        for e in EVIDENCE:
             def score(r):
-                return r["T"] + w * (r["T"] - r["C"]) - math.sqrt(k / r["n"])
-            highest_wrong = max(score(r) for r in rows if not r["right"])
-            threshold = highest_wrong + MARGIN
-            chosen = {key: max(pairs[key], key=score) for key in positives}
-            merged_right = sum(1 for c in chosen.values() if c["right"] and score(c) >= threshold)
-            print(f"  chance_weight {w:4.2f} evidence {k:3d}: highest wrong score {highest_wrong:.3f}, "
-                  f"threshold {threshold:.3f}, merged right {merged_right}/{len(positives)}")
-            if best is None or (merged_right, w, k) > best[:3]:
-                best = (merged_right, w, k, threshold)
-    merged_right, w, k, threshold = best
-    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {k}\n"
+                return r["T"] + w * (r["T"] - r["C"]) - math.sqrt(e / r["n"])
+            scores = {id(r): score(r) for r in rows}
+            tops = {}
+            for key, c in pairs.items():
+                judged = [r for r in c if not r["screened"] and r["n"] >= MIN_JUDGED]
+                if judged:
+                    tops[key] = max(judged, key=lambda r: scores[id(r)])
+            for k in RUNNER_UP:
+                for floor in FLOORS:
+                    def value(top):
+                        s = scores[id(top)]
+                        rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
+                        return s + k * (s - rival)
+                    values = {key: value(top) for key, top in tops.items()}
+                    wrong = [v for key, v in values.items() if not tops[key]["right"]]
+                    threshold = max(wrong) + MARGIN
+                    merged_right = sum(1 for key in positives
+                                       if key in tops and tops[key]["right"] and values[key] >= threshold)
+                    print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f}: "
+                          f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
+                          f"merged right {merged_right}/{len(positives)}")
+                    rank = (merged_right, -k, w, e, floor)
+                    if best is None or rank > best[0]:
+                        best = (rank, w, e, k, floor, threshold, merged_right)
+    _, w, e, k, floor, threshold, merged_right = best
+    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
+          f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
-          f"(margin {MARGIN} above the highest wrong candidate)")
+          f"(margin {MARGIN} above the highest wrong value)")
 
 
 if __name__ == "__main__":

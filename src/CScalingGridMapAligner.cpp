@@ -42,6 +42,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(hypotheses_per_level_pair, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(max_hypotheses, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(structure_search, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(exhaustive_search, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(xi_min, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lambda, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
@@ -57,6 +58,9 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_chance_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_runner_up_weight, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_runner_up_floor, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(distinct_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_threshold, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(min_confidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(use_resolution_metadata, bool, c, s);
@@ -99,6 +103,9 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
 	in("decision_chance_weight", decision_chance_weight, 0, 10);
 	in("decision_evidence", decision_evidence, 0, 1e6);
+	in("decision_runner_up_weight", decision_runner_up_weight, 0, 100);
+	in("decision_runner_up_floor", decision_runner_up_floor, -10, 10);
+	in("distinct_shift", distinct_shift, 1, 1e4);
 	in("decision_threshold", decision_threshold, 0, 10);
 	in("min_confidence", min_confidence, 0, 1);
 	in("metadata_scale_tolerance", metadata_scale_tolerance, 0, 10);
@@ -120,13 +127,14 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(hypotheses_per_level_pair, "RANSAC re-runs per level pair");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Try structure hypotheses when no feature one is confident");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(exhaustive_search, "Refine every hypothesis and always search the structure (calibration data)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_relative_tolerance, "TsICP stops below this relative gain");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_points, "Each hypothesis is first refined and judged on about this many points (0: off)");
-	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_margin, "Dropped there when its score is this far below decision_threshold");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_margin, "Dropped there when its score is this far below the lowest score that can merge");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_lattice_step, "Step of the finish's sub-cell shift on the coarser lattice (0: off) [coarse cells]");
@@ -135,11 +143,30 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = T + w (T - chance T) - sqrt(evidence / judged)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
-	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_threshold, "Score at confidence 0.5 (calibrated)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_weight, "Decision value = best score + w (it - best distinct rival's score)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_floor, "A rival scoring below this counts as this");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(distinct_shift, "Candidates this far apart are rivals [coarse cells]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_threshold, "Decision value at confidence 0.5 (calibrated)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(min_confidence, "Below this the maps are reported as not merged");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(use_resolution_metadata, "Use the stated resolutions as a scale prior");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(metadata_scale_tolerance, "Relative scale tolerance of that prior");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_map_cells, "Larger maps are refused (bounds peak memory)");
+}
+
+bool CScalingGridMapAligner::areRivals(const TCandidate& a, const TCandidate& b) const
+{
+	const double coarse = std::max({1.0, a.cells.scale, b.cells.scale});
+	const double turn = std::abs(std::remainder(a.cells.yaw - b.cells.yaw, 2 * M_PI));
+	return (a.other_centre - b.other_centre).norm() > options.distinct_shift * coarse ||
+		turn > options.verify_turn_deg * M_PI / 180 || std::abs(std::log(a.cells.scale / b.cells.scale)) > std::log(1.1);
+}
+
+double CScalingGridMapAligner::TConfigParams::lowestMergeableScore() const
+{
+	// value = s + k (s − rival) with rival ≥ floor, so value ≥ threshold needs
+	// (1 + k) s − k floor ≥ threshold.
+	return (decision_threshold + decision_runner_up_weight * decision_runner_up_floor) /
+		(1 + decision_runner_up_weight);
 }
 
 FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
@@ -213,6 +240,7 @@ double exactConfidence(double consistency, double overlap, double xi_min, double
 // Fewer wall points than this on the other map's seen space (in the weaker
 // direction) is too little overlap to judge.
 constexpr size_t kMinJudgedPoints = 40;
+
 }  // namespace
 
 namespace
@@ -459,7 +487,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return tc + options.decision_chance_weight * (tc - chance.consistency) -
 			std::sqrt(options.decision_evidence / std::max(1.0, judged));
 	};
-	auto candidate = [](const Hypothesis& h, const TsICPResult& r, double rmse_coarse, double cell_consistency,
+	Eigen::Vector2d other_centroid(0, 0);
+	for (const auto& p : other_edges) other_centroid += p;
+	other_centroid /= double(other_edges.size());
+	auto candidate = [&other_centroid](const Hypothesis& h, const TsICPResult& r, double rmse_coarse, double cell_consistency,
 						const TwoWaySupport& sup, const Chance& chance, double score) {
 		TCandidate c;
 		c.initial_cells = h.other_to_ref;
@@ -472,6 +503,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.support = sup.score();
 		c.judged_points = sup.judged();
 		c.score = score;
+		c.other_centre = r.transform.apply(other_centroid);
 		return c;
 	};
 	// With use_resolution_metadata, a refinement that leaves the stated scale is no candidate.
@@ -502,7 +534,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 						  << sup.consistency() << " chance " << chance.consistency << " score " << score);
 			// Only where neither way to be sure (below) is near: the maps are
 			// not the same cells, and their walls agree too little.
-			if (rmse_coarse >= kExactMaxRmse && score < options.decision_threshold - options.screen_margin)
+			if (rmse_coarse >= kExactMaxRmse && score < options.lowestMergeableScore() - options.screen_margin)
 			{
 				out.cand = candidate(h, quick, rmse_coarse, std::numeric_limits<double>::quiet_NaN(), sup, chance, score);
 				out.cand.screened = true;
@@ -533,20 +565,83 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
-		// Two ways to be sure: the maps coincide cell for cell, or (independent
-		// maps) their walls agree within the tolerance well above chance.
-		const double tolerant_conf = cand.judged_points < kMinJudgedPoints
-			? 0.0
-			: std::clamp(0.5 + (cand.score - options.decision_threshold) / 0.2, 0.0, 1.0);
-		cand.confidence = std::max(
-			may_be_exact ? exactConfidence(cell_consistency, r.overlap, ip.xi_min, rmse_coarse) : 0.0, tolerant_conf);
+		// The first way to be sure (the maps coincide cell for cell) is this
+		// candidate's alone; the second is the pair's (decide, below).
+		cand.exact_confidence = may_be_exact ? exactConfidence(cell_consistency, r.overlap, ip.xi_min, rmse_coarse) : 0.0;
+		cand.confidence = cand.exact_confidence;
 		out.r = r;
 		out.valid = true;
 		return out;
 	};
+	// Every judged candidate with what the report needs of its hypothesis.
+	struct Judged
+	{
+		Hypothesis h;
+		TsICPResult r;
+	};
+	std::vector<Judged> judged;
+	// Two ways to be sure: the maps coincide cell for cell (a candidate's
+	// exact_confidence), or (independent maps) the best-scoring candidate's
+	// walls agree well above chance and better than any distinct rival's
+	// (decisionValue). The chosen candidate's numbers go to `info`.
+	auto decide = [&]() {
+		auto& cands = info.candidates;
+		size_t best = cands.size();
+		for (size_t i = 0; i < cands.size(); ++i)
+			if (!cands[i].screened && cands[i].judged_points >= kMinJudgedPoints &&
+				(best == cands.size() || cands[i].score > cands[best].score))
+				best = i;
+		for (size_t i = 0; i < cands.size(); ++i)
+		{
+			TCandidate& c = cands[i];
+			c.confidence = c.exact_confidence;
+			if (i != best) continue;
+			// Screened candidates are no rivals: they scored below the lowest
+			// mergeable score less screen_margin, about the floor, on a sample.
+			c.runner_up_score = options.decision_runner_up_floor;
+			for (const auto& o : cands)
+				if (&o != &c && !o.screened && areRivals(c, o))
+					c.runner_up_score = std::max(c.runner_up_score, o.score);
+			c.decision_value =
+				c.score + options.decision_runner_up_weight * (c.score - c.runner_up_score);
+			c.confidence = std::max(
+				c.confidence,
+				std::clamp(
+					0.5 + (c.decision_value - options.decision_threshold) / (0.2 * (1 + options.decision_runner_up_weight)),
+					0.0, 1.0));
+		}
+		std::optional<size_t> chosen;
+		for (size_t i = 0; i < cands.size(); ++i)
+			if ((!chosen || cands[i].confidence > cands[*chosen].confidence ||
+				 (cands[i].confidence == cands[*chosen].confidence &&
+				  judged[i].r.objective < judged[*chosen].r.objective)))
+				chosen = i;
+		if (!chosen) return;
+		have = true;
+		const TCandidate& cand = cands[*chosen];
+		const Hypothesis& h = judged[*chosen].h;
+		const TsICPResult& r = judged[*chosen].r;
+		info.cells = r.transform;
+		info.initial_cells = h.other_to_ref;
+		info.overlap = r.overlap;
+		info.objective = r.objective;
+		info.trimmed_rmse_coarse_cells = cand.rmse_coarse_cells;
+		info.consistency = cand.tolerant_consistency;
+		info.chance_consistency = cand.chance_consistency;
+		info.score = cand.score;
+		info.runner_up_score = cand.runner_up_score;
+		info.decision_value = cand.decision_value;
+		info.confidence = cand.confidence;
+		info.ransac_inliers = h.inliers;
+		info.ransac_matches = h.matches;
+		info.icp_iterations = r.iterations;
+		info.objective_history = r.objective_history;
+	};
 	// Refined a few at a time (one per thread), judged in order: the result
-	// is the sequential one, at most a batch's tail computed in vain when a
-	// hypothesis is sure enough to stop at.
+	// is the sequential one, at most a batch's tail computed in vain when the
+	// maps are found to coincide cell for cell (no other hypothesis can do
+	// meaningfully better; a candidate sure only by the tolerant way is not,
+	// since a later distinct rival would lower it).
 	auto refineAll = [&](const std::vector<Hypothesis>& list) {
 		const size_t n = std::min<size_t>(list.size(), size_t(std::max(0, options.max_hypotheses)));
 		const size_t batch = size_t(std::clamp(cv::getNumThreads(), 1, 4));
@@ -557,40 +652,26 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			cv::parallel_for_(cv::Range(0, int(done.size())), [&](const cv::Range& range) {
 				for (int j = range.start; j < range.end; ++j) done[j] = refineOne(list[first + j]);
 			});
-			for (size_t j = 0; j < done.size() && !stop; ++j)
+			for (size_t j = 0; j < done.size(); ++j)
 			{
 				const Hypothesis& h = list[first + j];
 				const Refined& one = done[j];
 				++info.hypotheses_refined;
 				icp_s += one.icp_s, verify_s += one.verify_s;
 				if (!one.valid) continue;
-				const TsICPResult& r = one.r;
 				const TCandidate& cand = one.cand;
-				const double conf = cand.confidence;
 				info.candidates.push_back(cand);
+				judged.push_back({h, one.r});
 				MRPT_LOG_DEBUG_STREAM(
-					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << r.transform << " xi "
-								  << r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
+					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << one.r.transform << " xi "
+								  << one.r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
 								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
-								  << cand.score << " conf " << conf);
-				if (have && (conf < info.confidence || (conf == info.confidence && r.objective >= info.objective)))
-					continue;
-				have = true;
-				info.cells = r.transform;
-				info.initial_cells = h.other_to_ref;
-				info.overlap = r.overlap;
-				info.objective = r.objective;
-				info.trimmed_rmse_coarse_cells = cand.rmse_coarse_cells;
-				info.consistency = cand.tolerant_consistency;
-				info.chance_consistency = cand.chance_consistency;
-				info.confidence = conf;
-				info.ransac_inliers = h.inliers;
-				info.ransac_matches = h.matches;
-				info.icp_iterations = r.iterations;
-				info.objective_history = r.objective_history;
-				if (conf >= 0.95) stop = true;  // no other hypothesis can do meaningfully better
+								  << cand.score << (cand.screened ? " (screened)" : "") << " exact conf "
+								  << cand.exact_confidence);
+				if (cand.exact_confidence >= 0.95 && !options.exhaustive_search) stop = true;
 			}
 		}
+		decide();
 	};
 	// A given start first (tracking): confident, it needs no search.
 	if (start_metric)
@@ -601,7 +682,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		refineAll({h});
 	}
 	// 1. RANSAC on the features of every pair of pyramid levels.
-	info.tracked = have && info.confidence >= options.min_confidence;
+	info.tracked = have && info.confidence >= options.min_confidence && !options.exhaustive_search;
 	if (!info.tracked)
 	{
 		stage.Tic();
@@ -611,9 +692,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.hypotheses += hyps.size();
 		refineAll(hyps);
 	}
-	// Where no feature hypothesis convinces, the building's structure may
-	// (StructureHypotheses.h): independent maps whose corners differ.
-	if (options.structure_search && (!have || info.confidence < options.min_confidence))
+	// The building's structure gives more hypotheses (StructureHypotheses.h):
+	// right ones for independent maps whose corners differ, and rivals the
+	// decision must see (it was calibrated with them). Spared only where the
+	// maps coincide cell for cell, or a given start was confident.
+	const bool coincide = std::any_of(info.candidates.begin(), info.candidates.end(), [&](const TCandidate& c) {
+		return c.exact_confidence >= options.min_confidence;
+	});
+	if (options.structure_search && !info.tracked && (!coincide || options.exhaustive_search))
 	{
 		stage.Tic();
 		const auto more = structureHypotheses(ref_img, other_img, {}, expected_scale);
@@ -648,8 +734,11 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		std::ostringstream why;
 		why << "alignment not confident enough (confidence " << info.confidence << " < "
 			<< options.min_confidence << "; tolerant consistency " << info.consistency << " against "
-			<< info.chance_consistency << " by chance, overlap " << info.overlap << ", edge RMSE "
-			<< info.trimmed_rmse_coarse_cells << " cells)";
+			<< info.chance_consistency << " by chance";
+		if (std::isfinite(info.decision_value))
+			why << ", score " << info.score << " against " << info.runner_up_score << " for the best rival (decision value "
+				<< info.decision_value << ", " << options.decision_threshold << " needed)";
+		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
 		return fail(why.str());
 	}
 	info.success = true;

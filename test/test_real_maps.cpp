@@ -74,6 +74,52 @@ TEST(RealMaps, HalmstadCalibrationPairsMergeRight)
 	expectMergedRight("E5_09", "E5_07");  // SIFT finds nothing right: a structure hypothesis
 	expectMergedRight("E5_14", "E5_10");
 	expectMergedRight("HIH_04", "HIH_03");
+	expectMergedRight("E5_10", "E5_05");  // E5_05 is mostly unexplored
+}
+
+TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
+{
+	REQUIRE_HALMSTAD();
+	// The pair is decided on its best-scoring candidate, by its lead over the
+	// best candidate that puts the other map elsewhere: the decision value
+	// and the reported rival must be exactly those of the candidate list.
+	// E5_04 <- E5_02 merges, E5_06 <- E5_02 does not (calibration data).
+	const CScalingGridMapAligner aligner;
+	const auto& o = aligner.options;
+	ASSERT_GT(o.decision_runner_up_weight, 0);
+	for (const auto& [ref, other] : {std::pair{"E5_04", "E5_02"}, std::pair{"E5_06", "E5_02"}})
+	{
+		SCOPED_TRACE(std::string(ref) + " <- " + other);
+		const auto res = aligner.alignScaled(
+			loadGridMap(halmstad()->yaml(ref, dir())), loadGridMap(halmstad()->yaml(other, dir())));
+		const auto& cands = res.candidates;
+		ASSERT_GE(cands.size(), 2u);
+		const CScalingGridMapAligner::TCandidate* best = nullptr;
+		for (const auto& c : cands)
+			if (!c.screened && (!best || c.score > best->score)) best = &c;
+		ASSERT_NE(best, nullptr);
+		double rival = o.decision_runner_up_floor;
+		size_t rivals = 0;
+		for (const auto& c : cands)
+		{
+			if (&c == best) continue;
+			if (!c.screened && aligner.areRivals(*best, c)) rival = std::max(rival, c.score), ++rivals;
+			EXPECT_TRUE(std::isnan(c.decision_value)) << "only the best-scoring candidate is decided on";
+		}
+		// Pairs chosen for a rival above the floor (most rivals score below it).
+		EXPECT_GT(rival, o.decision_runner_up_floor) << rivals << " rivals";
+		EXPECT_DOUBLE_EQ(best->runner_up_score, rival);
+		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision_runner_up_weight * (best->score - rival));
+		EXPECT_EQ(res.success, best->decision_value >= o.decision_threshold);
+		if (res.success)
+		{
+			EXPECT_DOUBLE_EQ(res.decision_value, best->decision_value);
+		}
+		else
+		{
+			EXPECT_NE(res.message.find("best rival"), std::string::npos) << res.message;
+		}
+	}
 }
 
 TEST(RealMaps, HalmstadDifferentBuildingsAreRefused)
@@ -134,7 +180,7 @@ TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
 			if (c.screened)
 			{
 				++dropped;
-				EXPECT_LT(c.score, screened.options.decision_threshold - screened.options.screen_margin);
+				EXPECT_LT(c.score, screened.options.lowestMergeableScore() - screened.options.screen_margin);
 				EXPECT_EQ(c.confidence, 0);
 			}
 		EXPECT_GT(dropped, 0u) << "nothing screened on a refused pair";

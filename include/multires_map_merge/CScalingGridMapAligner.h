@@ -21,6 +21,7 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/slam/CMetricMapsAlignmentAlgorithm.h>
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -51,6 +52,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** When no feature hypothesis is confident, also try hypotheses from
 		 * the maps' structure (StructureHypotheses.h). */
 		bool structure_search = true;
+		/** Refine every hypothesis (up to max_hypotheses) and always search
+		 * the structure, even once the maps are found to coincide or a
+		 * candidate is confident: what calibration data is made with. */
+		bool exhaustive_search = false;
 		// --- TsICP
 		double xi_min = 0.35;
 		double lambda = 2.0;
@@ -61,7 +66,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * first refined by TsICP on about this many points of the fixed map
 		 * and judged on as many per map; unless the maps could be the same
 		 * cells there (edge RMSE < 1.5 coarse cells), one whose decision score
-		 * is more than `screen_margin` below `decision_threshold` is dropped
+		 * is more than `screen_margin` below lowestMergeableScore() is dropped
 		 * (TCandidate::screened) instead of refined on every point. 0: off. */
 		int screen_points = 1500;
 		double screen_margin = 0.15;
@@ -91,9 +96,22 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double decision_chance_weight = 1.0;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 400;
-		/** The score at which confidence is 0.5; ±0.1 around it spans 0..1. */
-		double decision_threshold = 0.477;
+		double decision_evidence = 1000;
+		/** The pair's decision value: the best-scoring candidate's score plus
+		 * this times its lead over the best distinct rival (distinct_shift):
+		 * the right alignment of one building stands out, a chance fit of
+		 * two buildings has rivals nearly as good. */
+		double decision_runner_up_weight = 4.0;
+		/** A rival scoring below this counts as this: with no rival, the lead
+		 * is measured from it. */
+		double decision_runner_up_floor = 0.0;
+		/** Candidates whose other-map wall centroids lie more than this many
+		 * coarse cells apart (or turned by over verify_turn_deg, or scaled by
+		 * over 10 %) are rivals, not one answer. */
+		double distinct_shift = 20.0;
+		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
+		 * decision_runner_up_weight) around it spans 0..1. */
+		double decision_threshold = 0.693;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -113,6 +131,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * non-finite values. loadFromConfigFile throws std::invalid_argument
 		 * with it; alignScaled reports it as not merged. */
 		std::string invalidReason() const;
+
+		/** The lowest candidate score whose decision value can reach
+		 * decision_threshold (with no rival above the floor). */
+		double lowestMergeableScore() const;
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
@@ -135,6 +157,17 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
+		/** From the cells alone (the maps coincide cell for cell); 0 when they cannot. */
+		double exact_confidence = 0;
+		/** Where the other map's wall centroid lands in the reference (cells):
+		 * tells rival candidates apart. */
+		Eigen::Vector2d other_centre{0, 0};
+		/** For the pair's best-scoring candidate only: the best distinct
+		 * rival's score (at least decision_runner_up_floor) and the decision
+		 * value score + runner_up_weight · (score − runner_up_score). */
+		double runner_up_score = std::numeric_limits<double>::quiet_NaN();
+		double decision_value = std::numeric_limits<double>::quiet_NaN();
+		/** max(exact_confidence, from decision_value for the best-scoring candidate) */
 		double confidence = 0;
 		/** Dropped by the cheap verification (screen_points): the numbers are
 		 * those of the sample, not refined further. */
@@ -165,6 +198,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Tolerant consistency of the chosen candidate (TCandidate), and
 		 * the best of it under far perturbations (chance). */
 		double consistency = 0, chance_consistency = 0;
+		/** The chosen candidate's score, and where it is the pair's best-
+		 * scoring one, its best distinct rival's score and the decision value
+		 * (TCandidate; NaN otherwise). */
+		double score = std::numeric_limits<double>::quiet_NaN();
+		double runner_up_score = std::numeric_limits<double>::quiet_NaN();
+		double decision_value = std::numeric_limits<double>::quiet_NaN();
 		double confidence = 0;  //!< in [0,1]
 		int ransac_inliers = 0;
 		int ransac_matches = 0;
@@ -201,6 +240,11 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		std::map<std::string, double> stage_seconds;  //!< features, edges
 	};
 	using PreparedMapPtr = std::shared_ptr<const TPreparedMap>;
+
+	/** Rivals, not one answer found twice: the candidates put the other map
+	 * elsewhere (its wall centroid more than distinct_shift coarse cells
+	 * apart, turned by more than verify_turn_deg, or scaled by over 10 %). */
+	bool areRivals(const TCandidate& a, const TCandidate& b) const;
 
 	/** Prepares one map with these options. Never throws on bad content:
 	 * the map's `problem` says what is wrong. */
