@@ -580,6 +580,21 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TsICPResult r;
 	};
 	std::vector<Judged> judged;
+	auto confidenceOfValue = [&](double value) {
+		return std::clamp(
+			0.5 + (value - options.decision_threshold) / (0.2 * (1 + options.decision_runner_up_weight)), 0.0, 1.0);
+	};
+	// Merged whatever the other hypotheses give: the maps coincide cell for
+	// cell, or the candidate's score alone (above the floor) reaches the
+	// confidence (a rival scores at most as much, so the decision value is at
+	// least the score;
+	// one scoring more would itself be merged). Searching on is then only
+	// time: independent maps never get there (calibration data).
+	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
+		return c.exact_confidence >= exact_needed ||
+			(!c.screened && c.judged_points >= kMinJudgedPoints && c.score >= options.decision_runner_up_floor &&
+			 confidenceOfValue(c.score) >= std::max(0.5, options.min_confidence));
+	};
 	// Two ways to be sure: the maps coincide cell for cell (a candidate's
 	// exact_confidence), or (independent maps) the best-scoring candidate's
 	// walls agree well above chance and better than any distinct rival's
@@ -604,11 +619,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					c.runner_up_score = std::max(c.runner_up_score, o.score);
 			c.decision_value =
 				c.score + options.decision_runner_up_weight * (c.score - c.runner_up_score);
-			c.confidence = std::max(
-				c.confidence,
-				std::clamp(
-					0.5 + (c.decision_value - options.decision_threshold) / (0.2 * (1 + options.decision_runner_up_weight)),
-					0.0, 1.0));
+			c.confidence = std::max(c.confidence, confidenceOfValue(c.decision_value));
 		}
 		std::optional<size_t> chosen;
 		for (size_t i = 0; i < cands.size(); ++i)
@@ -668,7 +679,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
 								  << cand.score << (cand.screened ? " (screened)" : "") << " exact conf "
 								  << cand.exact_confidence);
-				if (cand.exact_confidence >= 0.95 && !options.exhaustive_search) stop = true;
+				if (mergedWhateverComes(cand, 0.95) && !options.exhaustive_search) stop = true;
 			}
 		}
 		decide();
@@ -694,12 +705,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	}
 	// The building's structure gives more hypotheses (StructureHypotheses.h):
 	// right ones for independent maps whose corners differ, and rivals the
-	// decision must see (it was calibrated with them). Spared only where the
-	// maps coincide cell for cell, or a given start was confident.
-	const bool coincide = std::any_of(info.candidates.begin(), info.candidates.end(), [&](const TCandidate& c) {
-		return c.exact_confidence >= options.min_confidence;
+	// decision must see (it was calibrated with them). Spared only where a
+	// candidate is merged whatever comes, or a given start was confident.
+	const bool sure = std::any_of(info.candidates.begin(), info.candidates.end(), [&](const TCandidate& c) {
+		return mergedWhateverComes(c, options.min_confidence);
 	});
-	if (options.structure_search && !info.tracked && (!coincide || options.exhaustive_search))
+	if (options.structure_search && !info.tracked && (!sure || options.exhaustive_search))
 	{
 		stage.Tic();
 		const auto more = structureHypotheses(ref_img, other_img, {}, expected_scale);
