@@ -240,7 +240,6 @@ double exactConfidence(double consistency, double overlap, double xi_min, double
 // Fewer wall points than this on the other map's seen space (in the weaker
 // direction) is too little overlap to judge.
 constexpr size_t kMinJudgedPoints = 40;
-
 }  // namespace
 
 namespace
@@ -587,9 +586,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// Merged whatever the other hypotheses give: the maps coincide cell for
 	// cell, or the candidate's score alone (above the floor) reaches the
 	// confidence (a rival scores at most as much, so the decision value is at
-	// least the score;
-	// one scoring more would itself be merged). Searching on is then only
-	// time: independent maps never get there (calibration data).
+	// least the score; one scoring more would itself be merged). Searching on
+	// is then only time: independent maps never get there (calibration data).
 	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
 		return c.exact_confidence >= exact_needed ||
 			(!c.screened && c.judged_points >= kMinJudgedPoints && c.score >= options.decision_runner_up_floor &&
@@ -598,7 +596,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// Two ways to be sure: the maps coincide cell for cell (a candidate's
 	// exact_confidence), or (independent maps) the best-scoring candidate's
 	// walls agree well above chance and better than any distinct rival's
-	// (decisionValue). The chosen candidate's numbers go to `info`.
+	// (its decision value). The chosen candidate's numbers go to `info`.
 	auto decide = [&]() {
 		auto& cands = info.candidates;
 		size_t best = cands.size();
@@ -649,10 +647,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.objective_history = r.objective_history;
 	};
 	// Refined a few at a time (one per thread), judged in order: the result
-	// is the sequential one, at most a batch's tail computed in vain when the
-	// maps are found to coincide cell for cell (no other hypothesis can do
-	// meaningfully better; a candidate sure only by the tolerant way is not,
-	// since a later distinct rival would lower it).
+	// is the sequential one, at most a batch's tail computed in vain when a
+	// candidate is merged whatever comes (the maps coincide cell for cell
+	// with confidence 0.95, so no other hypothesis can do meaningfully
+	// better, or its score alone reaches the threshold).
 	auto refineAll = [&](const std::vector<Hypothesis>& list) {
 		const size_t n = std::min<size_t>(list.size(), size_t(std::max(0, options.max_hypotheses)));
 		const size_t batch = size_t(std::clamp(cv::getNumThreads(), 1, 4));
