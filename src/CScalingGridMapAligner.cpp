@@ -126,7 +126,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(ransac_min_inliers, "Fewest RANSAC inliers for a hypothesis");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(hypotheses_per_level_pair, "RANSAC re-runs per level pair");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
-	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Try structure hypotheses when no feature one is confident");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Also try structure hypotheses (unless a feature one is merged whatever comes)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(exhaustive_search, "Refine every hypothesis and always search the structure (calibration data)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");

@@ -49,8 +49,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		int ransac_min_inliers = 5;
 		int hypotheses_per_level_pair = 2;
 		int max_hypotheses = 8;  //!< refined by TsICP, most inliers first
-		/** When no feature hypothesis is confident, also try hypotheses from
-		 * the maps' structure (StructureHypotheses.h). */
+		/** Also try hypotheses from the maps' structure
+		 * (StructureHypotheses.h), unless a feature hypothesis is merged
+		 * whatever comes: they are right ones for independent maps and the
+		 * rivals the decision weighs. */
 		bool structure_search = true;
 		/** Refine every hypothesis (up to max_hypotheses) and always search
 		 * the structure, even once the maps are found to coincide or a
