@@ -7,8 +7,10 @@ The CSVs come from the benchmark (bench/multires_bench writes candidates.csv:
 every refined hypothesis of every pair, its features and whether it was right
 against the truth). Only rows marked calibration=1 are used: Halmstad E5 and
 HIH sensor pairs (positives), cross-site pairs with an E5 map, the CARMEN
-different-building and disjoint-part pairs at both resolution orders, and
-every E5 and HIH map against its own mirror image (negatives). F5 and KPT4A rows are
+different-building and disjoint-part pairs at both resolution orders, the
+first 15 % of a CARMEN run against a whole other building (little seen: the
+evidence discount decides), and every E5 and HIH map against its own mirror
+image (negatives). F5 and KPT4A rows are
 the acceptance set and are never read here.
 
 The decision (src/CScalingGridMapAligner.cpp) scores each refined candidate by
@@ -25,7 +27,10 @@ where rival is the best score of a candidate that puts the other map
 elsewhere (its wall centroid more than distinct_shift coarse cells away,
 turned by more than verify_turn_deg, or scaled by more than 10 %): the right
 alignment of one building stands out, a chance fit between two buildings has
-rivals nearly as good. The pair is merged when value >= threshold.
+rivals nearly as good. The other map's mirror image is aligned too (the
+aligner's mirror_check; rows with mirrored=1): each of its candidates is a
+rival and never the best, so a map against its own mirror image, which fits
+itself mirrored exactly, is refused. The pair is merged when value >= threshold.
 
 This script picks chance_weight, evidence, runner_up_weight and floor (the
 most right merges; ties go to the smaller runner-up weight, then the larger
@@ -69,6 +74,7 @@ def load(paths):
                     "positive": r["positive"] == "1",
                     "right": r["right"] == "1",
                     "screened": r.get("screened") == "1",
+                    "mirrored": r.get("mirrored") == "1",
                     "T": float(r["tolerant_consistency"]),
                     "C": float(r["chance_consistency"]),
                     "n": max(1, int(r["judged"])),
@@ -95,7 +101,7 @@ def main():
     for r in rows:
         pairs[r["pair"]].append(r)
     # Which candidates are rivals of which does not depend on the weights.
-    rivals = {id(r): [o for o in c if o is not r and not o["screened"] and distinct(r, o)]
+    rivals = {id(r): [o for o in c if o is not r and not o["screened"] and (o["mirrored"] or distinct(r, o))]
               for c in pairs.values() for r in c}
     positives = [k for k, c in pairs.items() if c[0]["positive"]]
     reachable = [k for k in positives if any(x["right"] for x in pairs[k])]
@@ -109,7 +115,7 @@ def main():
             scores = {id(r): score(r) for r in rows}
             tops = {}
             for key, c in pairs.items():
-                judged = [r for r in c if not r["screened"] and r["n"] >= MIN_JUDGED]
+                judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
                 if judged:
                     tops[key] = max(judged, key=lambda r: scores[id(r)])
             for k in RUNNER_UP:

@@ -43,6 +43,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(max_hypotheses, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(structure_search, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(exhaustive_search, bool, c, s);
+	MRPT_LOAD_CONFIG_VAR(mirror_check, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(xi_min, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(lambda, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_max_iterations, int, c, s);
@@ -128,6 +129,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Also try structure hypotheses (unless a feature one is merged whatever comes)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(exhaustive_search, "Refine every hypothesis and always search the structure (calibration data)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(mirror_check, "Before merging on the decision value, the mirrored other map's best score counts as a rival");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
@@ -167,6 +169,23 @@ double CScalingGridMapAligner::TConfigParams::lowestMergeableScore() const
 	// (1 + k) s − k floor ≥ threshold.
 	return (decision_threshold + decision_runner_up_weight * decision_runner_up_floor) /
 		(1 + decision_runner_up_weight);
+}
+
+double CScalingGridMapAligner::TConfigParams::relevantScore(double best_score) const
+{
+	// A rival r lowers the confidence of value s + k (s − r) while that is
+	// below the value of confidence 1: r > s − (V₁ − s)/k. A better s raises
+	// both bounds, so the least relevant score only rises.
+	const double k = decision_runner_up_weight;
+	if (!(k > 0) || !std::isfinite(best_score)) return lowestMergeableScore();
+	const double value_for_certainty = decision_threshold + 0.5 * valuePerConfidence();
+	return std::max(lowestMergeableScore(), std::min(best_score, best_score - (value_for_certainty - best_score) / k));
+}
+
+double CScalingGridMapAligner::TConfigParams::valuePerConfidence() const
+{
+	// Confidence 0.5 at the threshold, rising by 1 over 0.2 (1 + k) of value.
+	return 0.2 * (1 + decision_runner_up_weight);
 }
 
 FeatureParams CScalingGridMapAligner::TConfigParams::featureParams() const
@@ -227,13 +246,19 @@ std::string checkGrid(const COccupancyGridMap2D& g)
 // At this edge RMSE (coarse cells) or more the maps are not the same cells:
 // exactConfidence is 0 whatever the cells say.
 constexpr double kExactMaxRmse = 1.5;
+// At this cell consistency or less, neither. The screen's tolerant
+// consistency (walls 3 coarse cells apart do not conflict) is the same
+// count with a wider margin: on the calibration pairs it never fell more
+// than 0.03 below the cell consistency; 0.05 less leaves room for its sample.
+constexpr double kExactMinConsistency = 0.7;
+constexpr double kExactMinScreenConsistency = kExactMinConsistency - 0.05;
 
 double exactConfidence(double consistency, double overlap, double xi_min, double rmse_coarse)
 {
 	const double exact = std::clamp((0.5 - rmse_coarse) / 0.2, 0.0, 1.0);
 	const double pinned = std::max(exact, std::clamp((overlap - xi_min) / 0.02, 0.0, 1.0));
 	const double tight = std::clamp(kExactMaxRmse - rmse_coarse, 0.0, 1.0);
-	const double agree = std::clamp((consistency - 0.7) / 0.25, 0.0, 1.0);
+	const double agree = std::clamp((consistency - kExactMinConsistency) / 0.25, 0.0, 1.0);
 	return agree * std::min(pinned, tight);
 }
 
@@ -373,24 +398,42 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 	}
 	p->cell_to_metric = cellToMetric(grid);
 
-	// 1. The map as an image; features over a resolution pyramid.
+	// 1. The map as an image; features over a resolution pyramid (describe).
 	mrpt::system::CTicTac stage;
 	p->classes = toClassImage(grid);
+	p->stage_seconds["features"] = stage.Tac();
 	// Said plainly here rather than as "no feature matches" later.
 	const int occupied = cv::countNonZero(p->classes == kOccupied), free = cv::countNonZero(p->classes == kFree);
 	if (occupied + free == 0) p->problem = "is all unknown: nothing to align";
 	else if (occupied == 0) p->problem = "has no occupied cells: nothing to align";
 	else if (free == 0) p->problem = "has no free cells: no walls to align";
 	if (!p->problem.empty()) return p;
-	p->features = extractPyramidFeatures(p->classes, p->feature_params);
-	p->stage_seconds["features"] = stage.Tac();
+	describe(*p);
+	return p;
+}
+
+void CScalingGridMapAligner::describe(TPreparedMap& p) const
+{
+	mrpt::system::CTicTac stage;
+	p.features = extractPyramidFeatures(p.classes, p.feature_params);
+	p.stage_seconds["features"] += stage.Tac();
 
 	// 2. Edge points, and what the verification judges them against.
 	stage.Tic();
-	p->edges = edgePoints(p->classes);
-	if (p->edges.size() >= 3) p->edge_tree = std::make_shared<const PointKDTree>(p->edges);
-	p->field = occupancyField(p->classes);
-	p->stage_seconds["edges"] = stage.Tac();
+	p.edges = edgePoints(p.classes);
+	if (p.edges.size() >= 3) p.edge_tree = std::make_shared<const PointKDTree>(p.edges);
+	p.field = occupancyField(p.classes);
+	p.stage_seconds["edges"] += stage.Tac();
+}
+
+CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::mirrored(const TPreparedMap& map) const
+{
+	auto p = std::make_shared<TPreparedMap>();
+	p->resolution = map.resolution;
+	p->feature_params = map.feature_params;
+	p->cell_to_metric = map.cell_to_metric;  // not a frame: only cells are compared
+	cv::flip(map.classes, p->classes, 1);
+	describe(*p);
 	return p;
 }
 
@@ -425,7 +468,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 }
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
-	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const
+	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric,
+	bool mirror_pass, double mirror_pass_relevant) const
 {
 	mrpt::system::CTicTac total, stage;
 	TReturnInfo info;
@@ -510,6 +554,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return !expected_scale ||
 			std::abs(std::log(t.scale / *expected_scale)) <= std::log1p(options.metadata_scale_tolerance);
 	};
+	// The screen's bar (refineOne): below it a hypothesis can neither merge
+	// nor, as a rival, lower the best candidate's confidence; raised by
+	// refineAll as better candidates are found.
+	const double least_relevant = std::max(
+		options.lowestMergeableScore(), mirror_pass && !options.exhaustive_search ? mirror_pass_relevant : -1e9);
+	double screen_bar = least_relevant - options.screen_margin;
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
 		mrpt::system::CTicTac clock;
@@ -533,7 +583,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 						  << sup.consistency() << " chance " << chance.consistency << " score " << score);
 			// Only where neither way to be sure (below) is near: the maps are
 			// not the same cells, and their walls agree too little.
-			if (rmse_coarse >= kExactMaxRmse && score < options.lowestMergeableScore() - options.screen_margin)
+			const bool may_be_exact = rmse_coarse < kExactMaxRmse && sup.consistency() > kExactMinScreenConsistency;
+			if (!may_be_exact && score < screen_bar)
 			{
 				out.cand = candidate(h, quick, rmse_coarse, std::numeric_limits<double>::quiet_NaN(), sup, chance, score);
 				out.cand.screened = true;
@@ -580,8 +631,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	};
 	std::vector<Judged> judged;
 	auto confidenceOfValue = [&](double value) {
-		return std::clamp(
-			0.5 + (value - options.decision_threshold) / (0.2 * (1 + options.decision_runner_up_weight)), 0.0, 1.0);
+		return std::clamp(0.5 + (value - options.decision_threshold) / options.valuePerConfidence(), 0.0, 1.0);
 	};
 	// Merged whatever the other hypotheses give: the maps coincide cell for
 	// cell, or the candidate's score alone (above the floor) reaches the
@@ -601,7 +651,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		auto& cands = info.candidates;
 		size_t best = cands.size();
 		for (size_t i = 0; i < cands.size(); ++i)
-			if (!cands[i].screened && cands[i].judged_points >= kMinJudgedPoints &&
+			if (!cands[i].screened && !cands[i].mirrored && cands[i].judged_points >= kMinJudgedPoints &&
 				(best == cands.size() || cands[i].score > cands[best].score))
 				best = i;
 		for (size_t i = 0; i < cands.size(); ++i)
@@ -613,7 +663,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			// mergeable score less screen_margin, about the floor, on a sample.
 			c.runner_up_score = options.decision_runner_up_floor;
 			for (const auto& o : cands)
-				if (&o != &c && !o.screened && areRivals(c, o))
+				if (&o != &c && !o.screened && (o.mirrored || areRivals(c, o)))
 					c.runner_up_score = std::max(c.runner_up_score, o.score);
 			c.decision_value =
 				c.score + options.decision_runner_up_weight * (c.score - c.runner_up_score);
@@ -621,7 +671,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		}
 		std::optional<size_t> chosen;
 		for (size_t i = 0; i < cands.size(); ++i)
-			if ((!chosen || cands[i].confidence > cands[*chosen].confidence ||
+			if (!cands[i].mirrored && (!chosen || cands[i].confidence > cands[*chosen].confidence ||
 				 (cands[i].confidence == cands[*chosen].confidence &&
 				  judged[i].r.objective < judged[*chosen].r.objective)))
 				chosen = i;
@@ -646,6 +696,15 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.icp_iterations = r.iterations;
 		info.objective_history = r.objective_history;
 	};
+	// A hypothesis whose sample score is screen_margin below the relevant
+	// score of the best candidate so far (relevantScore) changes neither the
+	// decision nor the confidence, beyond the sample's noise: screened.
+	auto screenBar = [&]() {
+		double best = -std::numeric_limits<double>::infinity();
+		for (const auto& c : info.candidates)
+			if (!c.screened && !c.mirrored && c.judged_points >= kMinJudgedPoints) best = std::max(best, c.score);
+		return std::max(least_relevant, options.relevantScore(best)) - options.screen_margin;
+	};
 	// Refined a few at a time (one per thread), judged in order: the result
 	// is the sequential one, at most a batch's tail computed in vain when a
 	// candidate is merged whatever comes (the maps coincide cell for cell
@@ -657,6 +716,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		bool stop = false;
 		for (size_t first = 0; first < n && !stop; first += batch)
 		{
+			if (!options.exhaustive_search) screen_bar = screenBar();
 			std::vector<Refined> done(std::min(batch, n - first));
 			cv::parallel_for_(cv::Range(0, int(done.size())), [&](const cv::Range& range) {
 				for (int j = range.start; j < range.end; ++j) done[j] = refineOne(list[first + j]);
@@ -708,7 +768,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	const bool sure = std::any_of(info.candidates.begin(), info.candidates.end(), [&](const TCandidate& c) {
 		return mergedWhateverComes(c, options.min_confidence);
 	});
-	if (options.structure_search && !info.tracked && (!sure || options.exhaustive_search))
+	if (options.structure_search && !info.tracked && !mirror_pass && (!sure || options.exhaustive_search))
 	{
 		stage.Tic();
 		const auto more = structureHypotheses(ref_img, other_img, {}, expected_scale);
@@ -718,6 +778,38 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	}
 	info.stage_seconds["icp"] = icp_s;
 	info.stage_seconds["verify"] = verify_s;
+	if (mirror_pass) return info;  // its candidates are all the caller needs
+
+	// The mirror check (mirror_check): a merge that does not rest on
+	// coinciding cells rests on walls agreeing, which a mirror image can
+	// reach on a building's symmetries; the mirrored map's candidates become
+	// rivals. (In calibration data, every pair is checked.)
+	const bool rests_on_walls = have && info.confidence >= options.min_confidence &&
+		std::none_of(info.candidates.begin(), info.candidates.end(),
+					 [&](const TCandidate& c) { return c.exact_confidence >= options.min_confidence; });
+	if (options.mirror_check && !info.tracked && (rests_on_walls || (have && options.exhaustive_search)))
+	{
+		stage.Tic();
+		const PreparedMapPtr flipped = mirrored(other);
+		// Below this a mirrored candidate cannot lower the confidence (screenBar).
+		const double relevant = screenBar() + options.screen_margin;
+		const TReturnInfo m = align(ref, *flipped, std::nullopt, true, relevant);
+		for (TCandidate c : m.candidates)
+		{
+			c.mirrored = true;
+			if (!c.screened && c.judged_points >= kMinJudgedPoints)
+				info.mirror_score = std::isnan(info.mirror_score) ? c.score : std::max(info.mirror_score, c.score);
+			info.candidates.push_back(c);
+			Judged j;
+			j.h.other_to_ref = c.initial_cells;
+			j.r.transform = c.cells;
+			judged.push_back(j);
+		}
+		info.hypotheses += m.hypotheses;
+		info.hypotheses_refined += m.hypotheses_refined;
+		decide();
+		info.stage_seconds["mirror"] = stage.Tac();
+	}
 	if (!have)
 		return fail(info.hypotheses ? "no hypothesis survived refinement"
 									: "no consistent feature matches or structure between the maps (do they overlap?)");
@@ -748,6 +840,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			why << ", score " << info.score << " against " << info.runner_up_score << " for the best rival (decision value "
 				<< info.decision_value << ", " << options.decision_threshold << " needed)";
 		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
+		if (info.mirror_score > info.score)
+			why << "; the other map fits better mirrored (score " << info.mirror_score
+				<< "): is one of the maps flipped (y axis up vs down)?";
 		return fail(why.str());
 	}
 	info.success = true;

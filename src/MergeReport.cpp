@@ -36,6 +36,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"score", num(r.score)},
 		{"runner_up_score", num(r.runner_up_score)},
 		{"decision_value", num(r.decision_value)},
+		{"mirror_score", num(r.mirror_score)},
 		{"confidence", num(r.confidence)},
 		{"icp_iterations", r.icp_iterations},
 		{"runtime_s", num(runtime_s)},

@@ -58,6 +58,13 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * the structure, even once the maps are found to coincide or a
 		 * candidate is confident: what calibration data is made with. */
 		bool exhaustive_search = false;
+		/** Before a pair is merged on its walls agreeing (not on coinciding
+		 * cells: exact_confidence), the other map is aligned once more
+		 * mirrored (its x axis flipped; feature hypotheses only): its
+		 * candidates are rivals. A map against its own mirror image, or a
+		 * flipped map, fits at least as well mirrored and is refused
+		 * (TReturnInfo::mirror_score). */
+		bool mirror_check = true;
 		// --- TsICP
 		double xi_min = 0.35;
 		double lambda = 2.0;
@@ -94,8 +101,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double verify_shift = 12.0;
 		double verify_turn_deg = 8.0;
 		// Calibrated (scripts/calibrate_decision.py, bench/results/calibration.txt):
-		// no wrong calibration candidate (mirror images included) passes.
-		double decision_chance_weight = 1.0;
+		// no wrong calibration candidate passes (mirror images refused by
+		// mirror_check).
+		double decision_chance_weight = 1.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 1000;
@@ -103,7 +111,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 4.0;
+		double decision_runner_up_weight = 3.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.0;
@@ -113,7 +121,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.693;
+		double decision_threshold = 0.456;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -137,6 +145,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** The lowest candidate score whose decision value can reach
 		 * decision_threshold (with no rival above the floor). */
 		double lowestMergeableScore() const;
+		/** The least score a further candidate needs to matter once the
+		 * best so far scores `best_score`: to merge, to beat it, or as a
+		 * rival to lower its confidence (below confidence 1). */
+		double relevantScore(double best_score) const;
+		/** Decision value per unit of confidence: 0.2 (1 + runner-up weight). */
+		double valuePerConfidence() const;
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
@@ -174,6 +188,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Dropped by the cheap verification (screen_points): the numbers are
 		 * those of the sample, not refined further. */
 		bool screened = false;
+		/** Found for the mirrored other map (mirror_check): a rival of
+		 * every candidate, never chosen. */
+		bool mirrored = false;
 	};
 
 	struct TReturnInfo : public mrpt::slam::TMetricMapAlignmentResult
@@ -206,6 +223,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double score = std::numeric_limits<double>::quiet_NaN();
 		double runner_up_score = std::numeric_limits<double>::quiet_NaN();
 		double decision_value = std::numeric_limits<double>::quiet_NaN();
+		/** The best score of the mirrored other map (mirror_check; NaN where
+		 * the check did not run). Above `score`: a map flipped in y? */
+		double mirror_score = std::numeric_limits<double>::quiet_NaN();
 		double confidence = 0;  //!< in [0,1]
 		int ransac_inliers = 0;
 		int ransac_matches = 0;
@@ -298,8 +318,16 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
 
    private:
+	/** Features, edge points and occupancy field of a map's `classes`. */
+	void describe(TPreparedMap& map) const;
+	/** The map with its x axis flipped, described (mirror_check). */
+	PreparedMapPtr mirrored(const TPreparedMap& map) const;
+	/** `mirror_pass`: the search of mirror_check on the mirrored other map
+	 * (no structure, no finish, no check of its own); hypotheses scoring
+	 * below `mirror_pass_relevant` (less screen_margin) are screened. */
 	TReturnInfo align(
-		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
+		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric,
+		bool mirror_pass = false, double mirror_pass_relevant = -1e9) const;
 };
 
 }  // namespace multires_map_merge
