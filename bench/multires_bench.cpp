@@ -475,7 +475,10 @@ ScalingCase runScalingCase(const std::string& self, int cells)
 		else if (line.rfind("MESSAGE ", 0) == 0)
 			c.message = line.substr(8);
 	if (!(c.seconds > 0)) throw std::runtime_error("scaling case " + cells_s + " failed (see " + out + ")");
-	fs::remove(ref_path), fs::remove(other_path);
+	if (std::getenv("MMM_BENCH_KEEP_SCALING"))  // for profiling the child: bench/README.md
+		std::cout << "kept " << ref_path << " " << other_path << std::endl;
+	else
+		fs::remove(ref_path), fs::remove(other_path);
 	std::cout << "scaling " << c.ref_w << "x" << c.ref_h << " cells: " << c.seconds << " s, peak " << c.peak_mb
 			  << " MB" << std::endl;
 	return c;
@@ -1014,6 +1017,8 @@ int main(int argc, char** argv)
 		"", "sets", "only these accuracy sets (resolution, other-logs, rotation), printing their medians", false, "",
 		"SETS", cmd);
 	TCLAP::SwitchArg fleet_arg("", "fleet-only", "only the fleet section (printed as markdown)", cmd);
+	TCLAP::ValueArg<int> scaling_arg(
+		"", "scaling-only", "only the scaling case of this many cells a side (e.g. 4000)", false, 0, "CELLS", cmd);
 	TCLAP::SwitchArg live_arg("", "live-only", "only the live node's latency (printed as markdown)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
 	TCLAP::ValueArg<std::string> mrpt_child("", "mrpt-align", "internal: MRPT's aligner in a fresh process", false, "", "REF", cmd);
@@ -1084,6 +1089,11 @@ int main(int argc, char** argv)
 		if (live_arg.isSet())
 		{
 			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 4 : 16));
+			return 0;
+		}
+		if (scaling_arg.isSet())
+		{
+			runScalingCase(fs::canonical("/proc/self/exe"), scaling_arg.getValue());
 			return 0;
 		}
 		if (fleet_arg.isSet())

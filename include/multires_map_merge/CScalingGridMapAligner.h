@@ -70,7 +70,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double lambda = 2.0;
 		int icp_max_iterations = 100;
 		double icp_relative_tolerance = 1e-7;
-		int icp_coarse_points = 0;   //!< TsICPParams::coarse_points
+		int icp_coarse_points = 10000;  //!< TsICPParams::coarse_points
 		/** Cheap verification before the expensive one: each hypothesis is
 		 * first refined by TsICP on about this many points of the fixed map
 		 * and judged on as many per map; unless the maps could be the same
