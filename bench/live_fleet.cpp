@@ -184,6 +184,9 @@ LiveLatency runLiveLatency(const ScansOf& scans, int states)
 			const double e = errorCells(maps_at[state][i], robots[i], status[i].in_world);
 			const bool right = !robots[i].other_building && e <= 2;
 			r.wrong_estimations += !right;
+			if (!right)
+				std::cout << "live t=" << start << " s: " << robots[i].name << " placed wrong, " << e << " coarse cells off"
+						  << std::endl;
 			if (right && r.placed_s < 0) r.placed_s = published;
 			r.final_error_cells = e;
 		}

@@ -839,33 +839,23 @@ void runExtraCalibrationNegatives(const HalmstadData& data)
 			std::cout << "negative " << m << " vs its mirror image: " << (r.success ? "MERGED (false)" : "refused") << std::endl;
 		}
 	fs::remove_all(dir);
-	for (size_t i = 0; i < kLogs.size(); ++i)
-		for (size_t j = 0; j < kLogs.size(); ++j)
-			if (i != j)
-			{
-				const ScanSequence& sa = scansOf(kLogs[i].name);
-				const ScanSequence& sb = scansOf(kLogs[j].name);
-				const auto r = benchAligner().alignScaled(
-					renderGrid(sa, 0, sa.size(), 0.08), renderGrid(sb, 0, sb.size(), 0.05));
-				writeCandidates("carmen", kLogs[i].name + "_8cm", kLogs[j].name + "_5cm", false, true, r, noTruth);
-				std::cout << "negative " << kLogs[i].name << " 8 cm vs " << kLogs[j].name << " 5 cm: "
-						  << (r.success ? "MERGED (false)" : "refused") << std::endl;
-			}
-	// A robot that has seen little of another building: few wall points, so
-	// the evidence discount decides (the first 15 % of a run at 5 cm
-	// against a whole other building at 8 cm).
-	for (size_t i = 0; i < kLogs.size(); ++i)
-		for (size_t j = 0; j < kLogs.size(); ++j)
-			if (i != j)
-			{
-				const ScanSequence& sa = scansOf(kLogs[i].name);
-				const ScanSequence& sb = scansOf(kLogs[j].name);
-				const auto r = benchAligner().alignScaled(
-					renderGrid(sa, 0, sa.size(), 0.08), renderGrid(sb, 0, sb.size() * 15 / 100, 0.05));
-				writeCandidates("carmen", kLogs[i].name + "_8cm", kLogs[j].name + "_first15_5cm", false, true, r, noTruth);
-				std::cout << "negative " << kLogs[i].name << " 8 cm vs the first 15 % of " << kLogs[j].name
-						  << " 5 cm: " << (r.success ? "MERGED (false)" : "refused") << std::endl;
-			}
+	// Each CARMEN building at 8 cm against each other one at 5 cm: whole,
+	// and as a robot that has seen little of it (the first 15 % of its run:
+	// few wall points, so the evidence discount decides).
+	for (const int percent : {100, 15})
+		for (size_t i = 0; i < kLogs.size(); ++i)
+			for (size_t j = 0; j < kLogs.size(); ++j)
+				if (i != j)
+				{
+					const ScanSequence& sa = scansOf(kLogs[i].name);
+					const ScanSequence& sb = scansOf(kLogs[j].name);
+					const auto r = benchAligner().alignScaled(
+						renderGrid(sa, 0, sa.size(), 0.08), renderGrid(sb, 0, sb.size() * percent / 100, 0.05));
+					const std::string part = percent < 100 ? "_first" + std::to_string(percent) : "";
+					writeCandidates("carmen", kLogs[i].name + "_8cm", kLogs[j].name + part + "_5cm", false, true, r, noTruth);
+					std::cout << "negative " << kLogs[i].name << " 8 cm vs " << kLogs[j].name << part << " 5 cm: "
+							  << (r.success ? "MERGED (false)" : "refused") << std::endl;
+				}
 }
 
 // ---------------------------------------------------------------- real independent maps (Halmstad)

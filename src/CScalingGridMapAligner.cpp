@@ -129,7 +129,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_hypotheses, "Hypotheses refined by TsICP");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(structure_search, "Also try structure hypotheses (unless a feature one is merged whatever comes)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(exhaustive_search, "Refine every hypothesis and always search the structure (calibration data)");
-	MRPT_SAVE_CONFIG_VAR_COMMENT(mirror_check, "Before merging on the decision value, the mirrored other map's best score counts as a rival");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(mirror_check, "Before merging on the walls (not on coinciding cells), the other map's mirror image is aligned too: its candidates are rivals");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(xi_min, "Smallest overlap TsICP may choose");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(lambda, "Overlap preference: psi = e/xi^(1+lambda)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_max_iterations, "TsICP iteration limit");
