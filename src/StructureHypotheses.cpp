@@ -16,15 +16,22 @@ namespace
 /** Cell coordinates of a map resampled by `f` (cell centres at integers). */
 Similarity2D resampling(double f) { return Similarity2D(f, 0, {0.5 * (f - 1), 0.5 * (f - 1)}); }
 
-/** The walls of a class image at `f` times its size, blurred by a cell so
- * that walls a cell apart still correlate. */
-cv::Mat wallImage(const cv::Mat& classes, double f)
+/** The walls (`occupied`: 255 on wall cells) at `f` times the map's size as
+ * 0/1 floats, a cell a wall where any wall cell lies under it (as
+ * resampleClasses keeps walls), blurred by `blur` cells. */
+cv::Mat wallImage(const cv::Mat& occupied, double f, double blur = 1.0)
 {
-	const cv::Mat down = f < 1 ? resampleClasses(classes, f) : classes;
 	cv::Mat walls;
-	const cv::Mat occupied = down == kOccupied;
-	occupied.convertTo(walls, CV_32F, 1.0 / 255);
-	cv::GaussianBlur(walls, walls, cv::Size(0, 0), 1.0);
+	if (f < 1)
+	{
+		cv::Mat frac;
+		const cv::Size size(std::max(1, cvRound(occupied.cols * f)), std::max(1, cvRound(occupied.rows * f)));
+		cv::resize(occupied, frac, size, 0, 0, cv::INTER_AREA);
+		cv::Mat(frac > 0).convertTo(walls, CV_32F, 1.0 / 255);
+	}
+	else
+		occupied.convertTo(walls, CV_32F, 1.0 / 255);
+	cv::GaussianBlur(walls, walls, cv::Size(0, 0), blur);
 	return walls;
 }
 
@@ -44,12 +51,7 @@ double dominantWallDirection(const cv::Mat& classes)
 {
 	// Walls at an angle are staircases of cells, whose gradients lean to the
 	// axes: blur well past a cell before taking directions.
-	const double f = fitFactor(classes, 768);
-	const cv::Mat down = f < 1 ? resampleClasses(classes, f) : classes;
-	cv::Mat walls;
-	const cv::Mat occupied = down == kOccupied;
-	occupied.convertTo(walls, CV_32F, 1.0 / 255);
-	cv::GaussianBlur(walls, walls, cv::Size(0, 0), 3.0);
+	const cv::Mat walls = wallImage(classes == kOccupied, fitFactor(classes, 768), 3.0);
 	cv::Mat gx, gy;
 	cv::Sobel(walls, gx, CV_32F, 1, 0);
 	cv::Sobel(walls, gy, CV_32F, 0, 1);
@@ -71,28 +73,20 @@ double dominantWallDirection(const cv::Mat& classes)
 	return d;
 }
 
-std::vector<Hypothesis> structureHypotheses(
-	const cv::Mat& ref_classes, const cv::Mat& other_classes, const StructureParams& p,
-	std::optional<double> expected_scale)
+namespace
 {
-	std::vector<Hypothesis> out;
-	if (ref_classes.empty() || other_classes.empty()) return out;
-	const double f_ref = fitFactor(ref_classes, p.working_size);
-	const double f_other = fitFactor(other_classes, p.working_size);
-	const cv::Mat a = wallImage(ref_classes, f_ref), b0 = wallImage(other_classes, f_other);
-	const double b_energy = cv::sum(b0.mul(b0))[0];
-	if (cv::sum(a)[0] <= 0 || b_energy <= 0) return out;
-
-	std::vector<double> scales;  // other full cells → ref full cells
-	if (expected_scale)
-		scales = {*expected_scale};
-	else
-		for (int k = static_cast<int>(std::floor(std::log2(p.min_scale) * p.steps_per_octave));
-			 std::pow(2.0, double(k) / p.steps_per_octave) <= p.max_scale * 1.0001; ++k)
-			if (std::pow(2.0, double(k) / p.steps_per_octave) >= p.min_scale * 0.9999)
-				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
-	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
-
+/** The correlation peaks (`peaks` per pose; pose = scale index × 4 +
+ * right-angle turn), with both maps at most `working_size` across; empty
+ * where a pose was skipped. */
+std::vector<std::vector<Scored>> searchPoses(
+	const cv::Mat& ref_occupied, const cv::Mat& other_occupied, int working_size, const std::vector<double>& scales,
+	double turn, int peaks)
+{
+	std::vector<std::vector<Scored>> found_per_pose(scales.size() * 4);
+	const double f_ref = fitFactor(ref_occupied, working_size);
+	const double f_other = fitFactor(other_occupied, working_size);
+	const cv::Mat a = wallImage(ref_occupied, f_ref), b0 = wallImage(other_occupied, f_other);
+	if (cv::sum(a)[0] <= 0 || cv::sum(b0.mul(b0))[0] <= 0) return found_per_pose;
 	const Similarity2D other_down = resampling(f_other);
 	// Where the other map would be enlarged (scale above one), the reference
 	// is shrunk instead: the canvas, and with it the DFTs, stay about twice
@@ -113,7 +107,6 @@ std::vector<Hypothesis> structureHypotheses(
 	// The poses (scale × right-angle turn) are independent: searched in
 	// parallel, each keeping its own peaks, gathered in pose order so the
 	// result does not depend on the threads.
-	std::vector<std::vector<Scored>> found_per_pose(scales.size() * 4);
 	cv::parallel_for_(cv::Range(0, int(scales.size() * 4)), [&](const cv::Range& range) {
 		for (int pose = range.start; pose < range.end; ++pose)
 		{
@@ -132,7 +125,7 @@ std::vector<Hypothesis> structureHypotheses(
 				// The poses searched: those whose other map fits three working
 				// sizes at the reference's working size (as before the shrink).
 				const auto [lo, hi] = placedSize(Similarity2D(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0}));
-				if (hi.x() - lo.x() + 1 > 3 * p.working_size || hi.y() - lo.y() + 1 > 3 * p.working_size) continue;
+				if (hi.x() - lo.x() + 1 > 3 * working_size || hi.y() - lo.y() + 1 > 3 * working_size) continue;
 			}
 			const double f_view = f_ref * std::min(1.0, f_other / (s * f_ref));
 			const Similarity2D lin(s * f_view / f_other, turn + k * M_PI / 2, {0, 0});
@@ -151,37 +144,49 @@ std::vector<Hypothesis> structureHypotheses(
 			// energy of both where they overlap (masked normalised cross-
 			// correlation): a shrunken, dense copy of the other map must not
 			// win by touching many walls.
-			RefView* view;
+			// Views and spectra are made outside the lock (the threads would
+			// wait on each other); the first one made is kept.
+			RefView* view = nullptr;
 			{
 				std::lock_guard<std::mutex> lock(spectra_mutex);
-				view = &ref_views[f_view];
-				if (view->walls.empty())
-				{
-					view->f = f_view, view->walls = wallImage(ref_classes, f_view);
-					view->has_walls = cv::sum(view->walls)[0] > 0;
-				}
+				if (auto it = ref_views.find(f_view); it != ref_views.end()) view = &it->second;
+			}
+			if (!view)
+			{
+				RefView made;
+				made.f = f_view, made.walls = wallImage(ref_occupied, f_view);
+				made.has_walls = cv::sum(made.walls)[0] > 0;
+				std::lock_guard<std::mutex> lock(spectra_mutex);
+				view = &ref_views.emplace(f_view, std::move(made)).first->second;
 			}
 			const cv::Mat& a = view->walls;
 			if (!view->has_walls) continue;
 			const int w = cv::getOptimalDFTSize(a.cols + bw), h = cv::getOptimalDFTSize(a.rows + bh);
+			// Real images: their spectra packed (CCS), half the work of complex ones.
 			auto spectrum = [&](const cv::Mat& img) {
 				cv::Mat pad = cv::Mat::zeros(h, w, CV_32F), f;
 				img.copyTo(pad(cv::Rect(0, 0, img.cols, img.rows)));
-				cv::dft(pad, f, cv::DFT_COMPLEX_OUTPUT);
+				cv::dft(pad, f, 0, img.rows);
 				return f;
 			};
 			auto correlate = [&](const cv::Mat& fx, const cv::Mat& fy) {
 				cv::Mat prod, c;
 				cv::mulSpectrums(fx, fy, prod, 0, true);
-				cv::idft(prod, c, cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+				cv::dft(prod, c, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
 				return c;
 			};
 			cv::Mat fa, fa2;
 			{
 				std::lock_guard<std::mutex> lock(spectra_mutex);
-				auto& cached = view->spectra[{w, h}];
-				if (cached.first.empty()) cached = {spectrum(a), spectrum(a.mul(a))};
-				fa = cached.first, fa2 = cached.second;
+				if (auto it = view->spectra.find({w, h}); it != view->spectra.end())
+					fa = it->second.first, fa2 = it->second.second;
+			}
+			if (fa.empty())
+			{
+				std::pair<cv::Mat, cv::Mat> made{spectrum(a), spectrum(a.mul(a))};
+				std::lock_guard<std::mutex> lock(spectra_mutex);
+				const auto& kept = view->spectra.emplace(std::make_pair(w, h), std::move(made)).first->second;
+				fa = kept.first, fa2 = kept.second;
 			}
 			cv::Mat footprint;
 			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
@@ -190,7 +195,7 @@ std::vector<Hypothesis> structureHypotheses(
 			cv::max(a_energy, 1e-3 * placed_energy, a_energy);
 			cv::sqrt(a_energy * placed_energy, a_energy);
 			cv::divide(corr, a_energy, corr);
-			for (int peak = 0; peak < p.peaks_per_pose; ++peak)
+			for (int peak = 0; peak < peaks; ++peak)
 			{
 				double best;
 				cv::Point at;
@@ -204,6 +209,29 @@ std::vector<Hypothesis> structureHypotheses(
 			}
 		}
 	});
+	return found_per_pose;
+}
+}  // namespace
+
+std::vector<Hypothesis> structureHypotheses(
+	const cv::Mat& ref_classes, const cv::Mat& other_classes, const StructureParams& p,
+	std::optional<double> expected_scale)
+{
+	std::vector<Hypothesis> out;
+	if (ref_classes.empty() || other_classes.empty()) return out;
+	std::vector<double> scales;  // other full cells → ref full cells
+	if (expected_scale)
+		scales = {*expected_scale};
+	else
+		for (int k = static_cast<int>(std::floor(std::log2(p.min_scale) * p.steps_per_octave));
+			 std::pow(2.0, double(k) / p.steps_per_octave) <= p.max_scale * 1.0001; ++k)
+			if (std::pow(2.0, double(k) / p.steps_per_octave) >= p.min_scale * 0.9999)
+				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
+	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
+	const cv::Mat ref_occupied = ref_classes == kOccupied, other_occupied = other_classes == kOccupied;
+	const auto found_per_pose =
+		searchPoses(ref_occupied, other_occupied, p.working_size, scales, turn, p.peaks_per_pose);
+	const double f_ref = fitFactor(ref_classes, p.working_size);
 	std::vector<Scored> found;
 	for (const auto& f : found_per_pose) found.insert(found.end(), f.begin(), f.end());
 	std::sort(found.begin(), found.end(), [](const Scored& x, const Scored& y) { return x.score > y.score; });
