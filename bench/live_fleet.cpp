@@ -43,12 +43,34 @@ double seconds(std::chrono::steady_clock::time_point since)
 
 /** RMS error of a placement over the robot's occupied cells, in cells of the
  * coarser of its map and robot1's. */
-double errorCells(const GridInFrame& map, const LiveRobot& r, const Similarity2D& in_world)
+double errorCells(const LiveMap& m, const Similarity2D& in_world)
 {
-	const Similarity2D truth(1, r.frame.phi(), {r.frame.x(), r.frame.y()});
-	return pointRmse(in_world, truth, occupiedPointsInMapFrame(map)) / std::max(0.05, r.res);
+	return pointRmse(in_world, m.frame_in_world, occupiedPointsInMapFrame(m.map)) / std::max(0.05, m.resolution);
 }
 }  // namespace
+
+std::vector<LiveMap> liveMapsAt(const ScansOf& scans, int state, int states)
+{
+	std::vector<LiveMap> out;
+	for (const auto& r : liveRobots())
+	{
+		const auto& s = scans(r.log);
+		const double share = double(state) / states;
+		const size_t b = size_t(r.begin * s.size()), e = size_t((r.begin + share * (r.end - r.begin)) * s.size());
+		const GridInFrame rendered = renderGridOffLattice(s, b, e, r.res, r.frame, 0.37 * r.res, 0.61 * r.res);
+		std_msgs::Header h;
+		h.frame_id = r.name + "/map";
+		h.stamp = ros::Time(state, 0);
+		LiveMap m;
+		m.robot = r.name;
+		m.map = ros1::gridFromMsg(ros1::msgFromGrid(rendered, h), r.name + "'s map");
+		m.frame_in_world = Similarity2D(1, r.frame.phi(), {r.frame.x(), r.frame.y()});
+		m.resolution = r.res;
+		m.other_building = r.other_building;
+		out.push_back(std::move(m));
+	}
+	return out;
+}
 
 double LiveLatency::maxEstimateSeconds() const
 {
@@ -112,24 +134,20 @@ LiveLatency runLiveLatency(const ScansOf& scans, int states)
 		out.robots.push_back(row);
 	}
 	// Every map state, and when the maps first can be merged (offline).
-	std::vector<std::vector<GridInFrame>> maps_at(states + 1);
+	std::vector<std::vector<LiveMap>> maps_at(states + 1);
 	for (int k = 1; k <= states; ++k)
 	{
-		for (const auto& r : robots)
-		{
-			const auto& s = scans(r.log);
-			const double share = double(k) / states;
-			const size_t b = size_t(r.begin * s.size()), e = size_t((r.begin + share * (r.end - r.begin)) * s.size());
-			maps_at[k].push_back(renderGridOffLattice(s, b, e, r.res, r.frame, 0.37 * r.res, 0.61 * r.res));
-		}
+		maps_at[k] = liveMapsAt(scans, k, states);
+		std::vector<GridInFrame> grids;
+		for (const auto& m : maps_at[k]) grids.push_back(m.map);
 		const bool all_known = std::all_of(out.robots.begin() + 1, out.robots.end(), [](const LiveRobotRow& r) {
 			return r.other_building || r.can_merge_state >= 0;
 		});
 		if (all_known) continue;
-		const FleetResult offline = placeFleet(maps_at[k], 0, CScalingGridMapAligner());
+		const FleetResult offline = placeFleet(grids, 0, CScalingGridMapAligner());
 		for (size_t i = 1; i < robots.size(); ++i)
 			if (offline.maps[i].placed && out.robots[i].can_merge_state < 0 && !robots[i].other_building &&
-				errorCells(maps_at[k][i], robots[i], offline.maps[i].in_reference) <= 2)
+				errorCells(maps_at[k][i], offline.maps[i].in_reference) <= 2)
 				out.robots[i].can_merge_state = k, out.robots[i].can_merge_s = (k - 1) * out.state_s;
 	}
 
@@ -147,7 +165,7 @@ LiveLatency runLiveLatency(const ScansOf& scans, int states)
 				std_msgs::Header h;
 				h.frame_id = robots[i].name + "/map";
 				h.stamp = ros::Time(state, 0);
-				const std::string why = live.onMap(robots[i].name, ros1::msgFromGrid(maps_at[state][i], h));
+				const std::string why = live.onMap(robots[i].name, ros1::msgFromGrid(maps_at[state][i].map, h));
 				if (!why.empty()) throw std::runtime_error("live bench: " + robots[i].name + ": " + why);
 			}
 			fed = state;
@@ -181,7 +199,7 @@ LiveLatency runLiveLatency(const ScansOf& scans, int states)
 				r.final_error_cells = -1;
 				continue;
 			}
-			const double e = errorCells(maps_at[state][i], robots[i], status[i].in_world);
+			const double e = errorCells(maps_at[state][i], status[i].in_world);
 			const bool right = !robots[i].other_building && e <= 2;
 			r.wrong_estimations += !right;
 			if (!right)

@@ -55,6 +55,19 @@ struct LiveLatency
 
 using ScansOf = std::function<const multires_map_merge::ScanSequence&(const std::string& log)>;
 
+/** One robot's map at one state of the live run, as the node receives it
+ * (through a `nav_msgs/OccupancyGrid`), with the truth. */
+struct LiveMap
+{
+	std::string robot;
+	multires_map_merge::GridInFrame map;
+	multires_map_merge::Similarity2D frame_in_world;  //!< its map frame in robot1's (the truth)
+	double resolution = 0;
+	bool other_building = false;
+};
+/** Every robot's map at state `state` (1..`states`) of the live run. */
+std::vector<LiveMap> liveMapsAt(const ScansOf& scans, int state, int states);
+
 /** The map_merge node on a simulated clock: every `state_s` seconds each
  * robot's map grows by 1/`states` of its share of the run; an estimation
  * starts every period (or when the previous one ends, if later), sees the

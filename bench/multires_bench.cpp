@@ -818,6 +818,38 @@ std::vector<Negative> runCarmenNegatives(bool quick)
 	return negatives;
 }
 
+/** The live bench's growing maps, pair by pair at a few states, both orders:
+ * fr079 robots against each other (judged against their frames: a wrong best
+ * candidate of a barely grown map is what a lower bar would place wrong) and
+ * against the intel robot (another building: negatives). The fleet sees these
+ * pairs again at every estimation, so the decision must hold on all states. */
+void runLiveFleetCalibrationPairs()
+{
+	const int states = 16;
+	for (const int state : {1, 2, 3, 4, 6, 8, 11, 16})
+	{
+		const auto maps = liveMapsAt(scansOf, state, states);
+		for (size_t a = 0; a < maps.size(); ++a)
+			for (size_t b = 0; b < maps.size(); ++b)
+			{
+				if (a == b) continue;
+				const LiveMap &ref = maps[a], &other = maps[b];
+				const bool positive = !ref.other_building && !other.other_building;
+				const auto r = benchAligner().alignScaled(ref.map, other.map);
+				const Similarity2D truth = ref.frame_in_world.inverse().compose(other.frame_in_world);
+				const auto points = occupiedPointsInMapFrame(other.map);
+				const double coarse = std::max(ref.resolution, other.resolution);
+				const std::string name = "_state" + std::to_string(state);
+				writeCandidates("live", ref.robot + name, other.robot + name, positive, true, r, [&](const Similarity2D& cells) {
+					const double e = pointRmse(candidateMetric(ref.map, cells, other.map), truth, points) / coarse;
+					return std::pair<double, bool>{e, e <= 2};
+				});
+				std::cout << "live state " << state << " " << ref.robot << " <- " << other.robot << ": "
+						  << (r.success ? "merged" : "refused") << std::endl;
+			}
+	}
+}
+
 /** Negatives for the calibration beyond the issue's list, of the kinds the
  * decision must also reject: each calibration-site map against its own
  * mirror image (a reflection is no similarity), and the CARMEN buildings at
@@ -999,6 +1031,8 @@ int main(int argc, char** argv)
 		"", "calibration-data", "only the calibration data (Halmstad E5/HIH, E5 cross-site and CARMEN negatives) "
 		"into candidates.csv, for scripts/calibrate_decision.py", cmd);
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
+	TCLAP::SwitchArg live_pairs_arg(
+		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
 	TCLAP::ValueArg<std::string> halmstad_arg(
 		"", "halmstad-only", "only the real-independent-maps section, on these sites (e.g. E5,HIH)", false, "", "SITES", cmd);
 	TCLAP::ValueArg<int> negatives_arg(
@@ -1049,12 +1083,13 @@ int main(int argc, char** argv)
 			// screen's included), of every pair, not on those a decision kept.
 			g_aligner_options.exhaustive_search = true;
 			const HalmstadData data(g_data + "/halmstad");
-			if (!extra_arg.getValue())
+			if (!extra_arg.getValue() && !live_pairs_arg.getValue())
 			{
 				runHalmstad(data, {"E5", "HIH"}, negatives_arg.getValue());
 				runCarmenNegatives(false);
 			}
-			runExtraCalibrationNegatives(data);
+			if (!live_pairs_arg.getValue()) runExtraCalibrationNegatives(data);
+			if (!extra_arg.getValue()) runLiveFleetCalibrationPairs();
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
 		}

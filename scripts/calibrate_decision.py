@@ -10,8 +10,10 @@ HIH sensor pairs (positives), cross-site pairs with an E5 map, the CARMEN
 different-building and disjoint-part pairs at both resolution orders, the
 first 15 % of a CARMEN run against a whole other building (little seen: the
 evidence discount decides), and every E5 and HIH map against its own mirror
-image (negatives). F5 and KPT4A rows are
-the acceptance set and are never read here.
+image (negatives), and the live bench's growing maps at a few states (site
+"live": each fr079 robot against each other, whose wrong best candidates
+must not merge, and against the intel robot, negatives). F5 and KPT4A rows
+are the acceptance set and are never read here.
 
 The decision (src/CScalingGridMapAligner.cpp) scores each refined candidate by
     score = T + chance_weight * (T - C) - sqrt(evidence / n)
@@ -60,6 +62,12 @@ FLOORS = [-0.5, 0.0, 0.25]
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
+# A live-fleet pair's best candidate off by more than 2 coarse cells (not
+# right) but at most this many is the right placement slid along a corridor
+# of a barely grown map (the finish refines it on every cell): neither right
+# nor wrong here. Farther ones are wrong. (Halmstad's own rule is the
+# annotation's: right within its tolerance, else wrong.)
+LIVE_NEAR_CELLS = 5.0
 
 
 def load(paths):
@@ -73,6 +81,8 @@ def load(paths):
                     "pair": (r["site"], r["ref"], r["other"]),
                     "positive": r["positive"] == "1",
                     "right": r["right"] == "1",
+                    "near": (r["site"] == "live" and r["right"] != "1" and r["error"] != "nan"
+                             and float(r["error"]) <= LIVE_NEAR_CELLS),
                     "screened": r.get("screened") == "1",
                     "mirrored": r.get("mirrored") == "1",
                     "T": float(r["tolerant_consistency"]),
@@ -103,10 +113,15 @@ def main():
     # Which candidates are rivals of which does not depend on the weights.
     rivals = {id(r): [o for o in c if o is not r and not o["screened"] and (o["mirrored"] or distinct(r, o))]
               for c in pairs.values() for r in c}
-    positives = [k for k, c in pairs.items() if c[0]["positive"]]
+    # Merges are counted on the Halmstad positives only (the tuning set);
+    # the live fleet's same-building pairs (site "live") only weigh where their
+    # best candidate is wrong: a barely grown map the fleet must not place.
+    positives = [k for k, c in pairs.items() if c[0]["positive"] and k[0] != "live"]
     reachable = [k for k in positives if any(x["right"] for x in pairs[k])]
+    live = [k for k, c in pairs.items() if c[0]["positive"] and k[0] == "live"]
     print(f"calibration data: {len(rows)} candidates, {len(positives)} positive pairs "
-          f"({len(reachable)} with a right candidate), {len(pairs) - len(positives)} negative pairs")
+          f"({len(reachable)} with a right candidate), {len(live)} live-fleet same-building pairs, "
+          f"{len(pairs) - len(positives) - len(live)} negative pairs")
     best = None
     for w in WEIGHTS:
         for e in EVIDENCE:
@@ -125,22 +140,25 @@ def main():
                         rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
                         return s + k * (s - rival)
                     values = {key: value(top) for key, top in tops.items()}
-                    wrong = [v for key, v in values.items() if not tops[key]["right"]]
+                    wrong = [v for key, v in values.items() if not tops[key]["right"] and not tops[key]["near"]]
                     threshold = max(wrong) + MARGIN
                     merged_right = sum(1 for key in positives
                                        if key in tops and tops[key]["right"] and values[key] >= threshold)
+                    live_right = sum(1 for key in live
+                                     if key in tops and tops[key]["right"] and values[key] >= threshold)
                     print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f}: "
                           f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
-                          f"merged right {merged_right}/{len(positives)}")
+                          f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
                     rank = (merged_right, -k, w, e, floor)
                     if best is None or rank > best[0]:
-                        best = (rank, w, e, k, floor, threshold, merged_right)
-    _, w, e, k, floor, threshold, merged_right = best
+                        best = (rank, w, e, k, floor, threshold, merged_right, live_right)
+    _, w, e, k, floor, threshold, merged_right, live_right = best
     print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
-          f"(margin {MARGIN} above the highest wrong value)")
+          f"(margin {MARGIN} above the highest wrong value); live fleet pairs merged right "
+          f"{live_right}/{len(live)}")
 
 
 if __name__ == "__main__":
