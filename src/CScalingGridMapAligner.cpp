@@ -469,8 +469,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric,
-	bool mirror_pass, double mirror_pass_relevant) const
+	std::optional<double> mirror_pass_relevant) const
 {
+	const bool mirror_pass = mirror_pass_relevant.has_value();
 	mrpt::system::CTicTac total, stage;
 	TReturnInfo info;
 	auto fail = [&](const std::string& why) {
@@ -557,8 +558,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// The screen's bar (refineOne): below it a hypothesis can neither merge
 	// nor, as a rival, lower the best candidate's confidence; raised by
 	// refineAll as better candidates are found.
-	const double least_relevant = std::max(
-		options.lowestMergeableScore(), mirror_pass && !options.exhaustive_search ? mirror_pass_relevant : -1e9);
+	const double least_relevant = mirror_pass && !options.exhaustive_search
+		? std::max(options.lowestMergeableScore(), *mirror_pass_relevant)
+		: options.lowestMergeableScore();
 	double screen_bar = least_relevant - options.screen_margin;
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
@@ -699,11 +701,16 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// A hypothesis whose sample score is screen_margin below the relevant
 	// score of the best candidate so far (relevantScore) changes neither the
 	// decision nor the confidence, beyond the sample's noise: screened.
-	auto screenBar = [&]() {
+	auto bestScore = [&]() {
 		double best = -std::numeric_limits<double>::infinity();
 		for (const auto& c : info.candidates)
 			if (!c.screened && !c.mirrored && c.judged_points >= kMinJudgedPoints) best = std::max(best, c.score);
-		return std::max(least_relevant, options.relevantScore(best)) - options.screen_margin;
+		return best;
+	};
+	// relevantScore is at least lowestMergeableScore; the mirror pass's own
+	// bar (least_relevant) may be higher.
+	auto screenBar = [&]() {
+		return std::max(least_relevant, options.relevantScore(bestScore())) - options.screen_margin;
 	};
 	// Refined a few at a time (one per thread), judged in order: the result
 	// is the sequential one, at most a batch's tail computed in vain when a
@@ -791,9 +798,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	{
 		stage.Tic();
 		const PreparedMapPtr flipped = mirrored(other);
-		// Below this a mirrored candidate cannot lower the confidence (screenBar).
-		const double relevant = screenBar() + options.screen_margin;
-		const TReturnInfo m = align(ref, *flipped, std::nullopt, true, relevant);
+		// Below this a mirrored candidate cannot lower the confidence.
+		const TReturnInfo m = align(ref, *flipped, std::nullopt, options.relevantScore(bestScore()));
 		for (TCandidate c : m.candidates)
 		{
 			c.mirrored = true;

@@ -325,12 +325,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	void describe(TPreparedMap& map) const;
 	/** The map with its x axis flipped, described (mirror_check). */
 	PreparedMapPtr mirrored(const TPreparedMap& map) const;
-	/** `mirror_pass`: the search of mirror_check on the mirrored other map
-	 * (no structure, no finish, no check of its own); hypotheses scoring
-	 * below `mirror_pass_relevant` (less screen_margin) are screened. */
+	/** With `mirror_pass_relevant`: the search of mirror_check on the
+	 * mirrored other map (no structure, no finish, no check of its own);
+	 * hypotheses scoring below that score (less screen_margin) are screened. */
 	TReturnInfo align(
 		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric,
-		bool mirror_pass = false, double mirror_pass_relevant = -1e9) const;
+		std::optional<double> mirror_pass_relevant = std::nullopt) const;
 };
 
 }  // namespace multires_map_merge
