@@ -106,7 +106,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// on E5/HIH pairs, cross-site, CARMEN, mirror and live-fleet data (growing
 		// partial maps of two buildings: without them a fit placed intel's robot
 		// in fr079): no wrong calibration candidate passes.
-		double decision_chance_weight = 1.5;
+		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 1000;
@@ -124,7 +124,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 1.632;
+		double decision_threshold = 0.753;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
