@@ -123,7 +123,8 @@ std::shared_ptr<const GridInFrame> mapServerFile(const std::string& log, bool re
 	const std::string path = (dir / name.str()).string();
 	saveGridMap(map, path);
 	auto loaded = std::make_shared<const GridInFrame>(loadGridMap(path));
-	fs::remove(path), fs::remove(fs::path(path).replace_extension(".pgm"));
+	if (!std::getenv("MMM_BENCH_KEEP_MAPS"))  // kept for one-pair runs: bench/README.md
+		fs::remove(path), fs::remove(fs::path(path).replace_extension(".pgm"));
 	return cache.emplace(key, loaded).first->second;
 }
 

@@ -252,6 +252,12 @@ constexpr double kExactMaxRmse = 1.5;
 // than 0.03 below the cell consistency; 0.05 less leaves room for its sample.
 constexpr double kExactMinConsistency = 0.7;
 constexpr double kExactMinScreenConsistency = kExactMinConsistency - 0.05;
+// A sample refinement this close to a candidate that coincides cell for cell
+// (centre in coarse cells, turn, log scale) is the same placement: within
+// the spread of TsICP's optima from different starts on one pair of maps.
+constexpr double kSamePlacementCells = 1.5;
+constexpr double kSamePlacementTurnDeg = 0.5;
+constexpr double kSamePlacementScale = 0.01;
 
 double exactConfidence(double consistency, double overlap, double xi_min, double rmse_coarse)
 {
@@ -562,6 +568,21 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		? std::max(options.lowestMergeableScore(), *mirror_pass_relevant)
 		: options.lowestMergeableScore();
 	double screen_bar = least_relevant - options.screen_margin;
+	// Candidates whose maps coincide cell for cell, found in earlier batches
+	// (refineAll): a hypothesis whose sample refinement lands on one of them
+	// is not refined again. Same-log maps give many hypotheses that all
+	// converge there; refining each on every point was most of the time on
+	// large maps. Read-only while a batch runs.
+	std::vector<TCandidate> exact_found;
+	auto onExactFound = [&](const Similarity2D& t) {
+		const Eigen::Vector2d centre = t.apply(other_centroid);
+		return std::any_of(exact_found.begin(), exact_found.end(), [&](const TCandidate& c) {
+			const double coarse = std::max({1.0, t.scale, c.cells.scale});
+			return (centre - c.other_centre).norm() <= kSamePlacementCells * coarse &&
+				std::abs(std::remainder(t.yaw - c.cells.yaw, 2 * M_PI)) <= kSamePlacementTurnDeg * M_PI / 180 &&
+				std::abs(std::log(t.scale / c.cells.scale)) <= kSamePlacementScale;
+		});
+	};
 	auto refineOne = [&](const Hypothesis& h) {
 		Refined out;
 		mrpt::system::CTicTac clock;
@@ -587,10 +608,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			// Only where neither way to be sure (below) is near: the maps are
 			// not the same cells, and their walls agree too little.
 			const bool may_be_exact = rmse_coarse < kExactMaxRmse && sup.consistency() > kExactMinScreenConsistency;
-			if (!may_be_exact && score < screen_bar)
+			const bool converged_on_exact = !options.exhaustive_search && onExactFound(quick.transform);
+			if ((!may_be_exact && score < screen_bar) || converged_on_exact)
 			{
 				out.cand = candidate(h, quick, rmse_coarse, std::numeric_limits<double>::quiet_NaN(), sup, chance, score);
 				out.cand.screened = true;
+				out.cand.converged_on_exact = converged_on_exact;
 				out.r = quick;
 				out.valid = true;
 				return out;
@@ -747,9 +770,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << one.r.transform << " xi "
 								  << one.r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
 								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
-								  << cand.score << (cand.screened ? " (screened)" : "") << " exact conf "
+								  << cand.score << (cand.converged_on_exact ? " (on an exact candidate)" : cand.screened ? " (screened)" : "") << " exact conf "
 								  << cand.exact_confidence);
 				if (mergedWhateverComes(cand, 0.95) && !options.exhaustive_search) stop = true;
+				if (!cand.screened && cand.exact_confidence >= options.min_confidence) exact_found.push_back(cand);
 			}
 		}
 		decide();

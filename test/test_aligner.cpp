@@ -111,6 +111,48 @@ TEST(Fr079, TheGroundTruthPairsOfThePaperAlign)
 	}
 }
 
+// Same-log maps give many hypotheses that converge on one placement: once a
+// candidate there coincides cell for cell, a hypothesis whose sample
+// refinement lands on it is not refined again, and the result is the one
+// refining every hypothesis gives.
+TEST(Search, HypothesesLandingOnAnExactCandidateAreNotRefinedAgain)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const ScanSequence& scans = scansOf(log);
+	CScalingGridMapAligner fast, every;
+	every.options.exhaustive_search = true;
+	size_t landed = 0;
+	for (const Case c : {Case{"fr079", 0.02, 0.02, 0, 0.6}, Case{"fr079", 0.04, 0.06, 33, 0.6}})
+	{
+		SCOPED_TRACE(::testing::PrintToString(c));
+		const auto pair = makePair(scans, c);
+		const auto a = fast.alignScaled(pair.ref, pair.other), b = every.alignScaled(pair.ref, pair.other);
+		expectAccurate(pair, a);
+		expectAccurate(pair, b);
+		for (size_t i = 0; i < a.candidates.size(); ++i)
+		{
+			const auto& c = a.candidates[i];
+			if (!c.converged_on_exact) continue;
+			++landed;
+			EXPECT_TRUE(c.screened);
+			const bool near_exact = std::any_of(a.candidates.begin(), a.candidates.begin() + i, [&](const auto& e) {
+				return !e.screened && e.exact_confidence >= fast.options.min_confidence && !fast.areRivals(e, c);
+			});
+			EXPECT_TRUE(near_exact) << "candidate " << i << " landed on no exact candidate found before it";
+		}
+		for (const auto& c : b.candidates) EXPECT_FALSE(c.converged_on_exact);
+		// The same placement to a fraction of a coarse cell at the map's corners.
+		const double coarse = std::max(pair.ref.getResolution(), pair.other.getResolution());
+		const double w = pair.other.getXMax() - pair.other.getXMin(), h = pair.other.getYMax() - pair.other.getYMin();
+		for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
+		{
+			const Eigen::Vector2d p = corner + Eigen::Vector2d(pair.other.getXMin(), pair.other.getYMin());
+			EXPECT_LT((a.metric.apply(p) - b.metric.apply(p)).norm() / coarse, 0.5);
+		}
+	}
+	EXPECT_GT(landed, 0u) << "no hypothesis landed on an exact candidate: the test checks nothing";
+}
+
 // A fleet prepares each map once and aligns it in several pairs: a prepared
 // pair must align exactly as the grids do, one map may serve both roles, and
 // maps prepared with other feature options are refused, not silently mixed.

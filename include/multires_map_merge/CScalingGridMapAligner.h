@@ -191,6 +191,11 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Dropped by the cheap verification (screen_points): the numbers are
 		 * those of the sample, not refined further. */
 		bool screened = false;
+		/** Not refined either: its sample result fell on a candidate already
+		 * found to coincide cell for cell (exact_confidence ≥ min_confidence),
+		 * where refining it again would find that candidate again. Also
+		 * `screened` (no rival, never chosen). */
+		bool converged_on_exact = false;
 		/** Found for the mirrored other map (mirror_check): a rival of
 		 * every candidate, never chosen. */
 		bool mirrored = false;
