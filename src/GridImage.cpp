@@ -28,21 +28,24 @@ Similarity2D cellToMetric(const mrpt::maps::COccupancyGridMap2D& grid)
 	return Similarity2D::cellToMetric(grid.getResolution(), grid.getXMin(), grid.getYMin());
 }
 
+cv::Mat resampleMask(const cv::Mat& mask, double factor)
+{
+	CV_Assert(mask.type() == CV_8UC1 && factor > 0);
+	const cv::Size size(std::max(1, cvRound(mask.cols * factor)), std::max(1, cvRound(mask.rows * factor)));
+	// INTER_AREA gives each output cell the fraction of set input cells under
+	// it; "any" is that fraction being non-zero.
+	cv::Mat frac;
+	cv::resize(mask, frac, size, 0, 0, factor < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
+	return frac > 0;
+}
+
 cv::Mat resampleClasses(const cv::Mat& classes, double factor)
 {
 	CV_Assert(classes.type() == CV_8UC1 && factor > 0);
-	const cv::Size size(
-		std::max(1, cvRound(classes.cols * factor)), std::max(1, cvRound(classes.rows * factor)));
-	// INTER_AREA gives each output cell the fraction of input cells of a class
-	// under it; "any" is that fraction being non-zero.
-	auto anyOf = [&](uint8_t cls) {
-		cv::Mat frac;
-		cv::resize(classes == cls, frac, size, 0, 0, factor < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
-		return frac > 0;
-	};
-	cv::Mat out(size, CV_8UC1, cv::Scalar(kUnknown));
-	out.setTo(kFree, anyOf(kFree));
-	out.setTo(kOccupied, anyOf(kOccupied));
+	const cv::Mat free = resampleMask(classes == kFree, factor);
+	cv::Mat out(free.size(), CV_8UC1, cv::Scalar(kUnknown));
+	out.setTo(kFree, free);
+	out.setTo(kOccupied, resampleMask(classes == kOccupied, factor));
 	return out;
 }
 

@@ -22,15 +22,7 @@ Similarity2D resampling(double f) { return Similarity2D(f, 0, {0.5 * (f - 1), 0.
 cv::Mat wallImage(const cv::Mat& occupied, double f, double blur = 1.0)
 {
 	cv::Mat walls;
-	if (f < 1)
-	{
-		cv::Mat frac;
-		const cv::Size size(std::max(1, cvRound(occupied.cols * f)), std::max(1, cvRound(occupied.rows * f)));
-		cv::resize(occupied, frac, size, 0, 0, cv::INTER_AREA);
-		cv::Mat(frac > 0).convertTo(walls, CV_32F, 1.0 / 255);
-	}
-	else
-		occupied.convertTo(walls, CV_32F, 1.0 / 255);
+	(f < 1 ? resampleMask(occupied, f) : occupied).convertTo(walls, CV_32F, 1.0 / 255);
 	cv::GaussianBlur(walls, walls, cv::Size(0, 0), blur);
 	return walls;
 }

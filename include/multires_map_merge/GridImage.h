@@ -39,6 +39,10 @@ cv::Mat toClassImage(const mrpt::maps::COccupancyGridMap2D& grid);
 /** Cell coordinates → metric coordinates of this grid, from its stated metadata. */
 Similarity2D cellToMetric(const mrpt::maps::COccupancyGridMap2D& grid);
 
+/** Resamples a mask (0 / non-zero) by `factor` (< 1 shrinks): an output
+ * cell is set (255) if any input cell under it is. */
+cv::Mat resampleMask(const cv::Mat& mask, double factor);
+
 /** Resamples a class image by `factor` (< 1 shrinks) the way a coarser grid
  * would have recorded the same world: a coarse cell is occupied if any fine
  * cell under it is, else free if any is, else unknown. A thin wall stays a
