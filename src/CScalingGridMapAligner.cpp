@@ -15,6 +15,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <future>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -453,7 +454,11 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const COccupancyGridMap2D& ref, const COccupancyGridMap2D& other) const
 {
 	mrpt::system::CTicTac total;
-	const PreparedMapPtr ref_map = prepare(ref), other_map = prepare(other);
+	// The two maps are independent: prepared at once (prepare logs nothing;
+	// OpenCV runs a parallel_for_ that finds its pool busy on the caller's
+	// thread). Most of that time is serial: distance field, edges, k-d tree.
+	auto other_prepared = std::async(std::launch::async, [&]() { return prepare(other); });
+	const PreparedMapPtr ref_map = prepare(ref), other_map = other_prepared.get();
 	TReturnInfo info = alignScaled(*ref_map, *other_map);
 	for (const auto* p : {ref_map.get(), other_map.get()})
 		for (const auto& [name, seconds] : p->stage_seconds) info.stage_seconds[name] += seconds;
