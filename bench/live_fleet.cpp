@@ -63,7 +63,8 @@ std::vector<LiveMap> liveMapsAt(const ScansOf& scans, int state, int states)
 		h.stamp = ros::Time(state, 0);
 		LiveMap m;
 		m.robot = r.name;
-		m.map = ros1::gridFromMsg(ros1::msgFromGrid(rendered, h), r.name + "'s map");
+		m.msg = ros1::msgFromGrid(rendered, h);
+		m.map = ros1::gridFromMsg(m.msg, r.name + "'s map");
 		m.frame_in_world = Similarity2D(1, r.frame.phi(), {r.frame.x(), r.frame.y()});
 		m.resolution = r.res;
 		m.other_building = r.other_building;
@@ -162,10 +163,7 @@ LiveLatency runLiveLatency(const ScansOf& scans, int states)
 		{
 			for (size_t i = 0; i < robots.size(); ++i)
 			{
-				std_msgs::Header h;
-				h.frame_id = robots[i].name + "/map";
-				h.stamp = ros::Time(state, 0);
-				const std::string why = live.onMap(robots[i].name, ros1::msgFromGrid(maps_at[state][i].map, h));
+				const std::string why = live.onMap(robots[i].name, maps_at[state][i].msg);
 				if (!why.empty()) throw std::runtime_error("live bench: " + robots[i].name + ": " + why);
 			}
 			fed = state;

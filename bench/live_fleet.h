@@ -6,6 +6,7 @@
 // 5 / 3 / 8 cm in their own frames and one of intel (another building).
 
 #include <multires_map_merge/GroundTruthPair.h>
+#include <nav_msgs/OccupancyGrid.h>
 
 #include <functional>
 #include <ostream>
@@ -60,7 +61,8 @@ using ScansOf = std::function<const multires_map_merge::ScanSequence&(const std:
 struct LiveMap
 {
 	std::string robot;
-	multires_map_merge::GridInFrame map;
+	nav_msgs::OccupancyGrid msg;  //!< what the node receives (header: the robot's map frame, stamp = state)
+	multires_map_merge::GridInFrame map;  //!< read back from `msg`, as the node reads it
 	multires_map_merge::Similarity2D frame_in_world;  //!< its map frame in robot1's (the truth)
 	double resolution = 0;
 	bool other_building = false;
