@@ -49,8 +49,9 @@ neither a pair's best nor anyone's rival. The screen's bar follows from the
 decision (lowestMergeableScore): after changing the defaults, regenerate the
 data and check that the fit stays.
 """
-import csv
 import collections
+import csv
+import itertools
 import math
 import sys
 
@@ -59,6 +60,9 @@ WEIGHTS = [0.5, 1.0, 1.5]
 EVIDENCE = [200, 400, 1000]
 RUNNER_UP = [0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0]
 FLOORS = [-0.5, 0.0, 0.25]
+# decision_min_lead: the best candidate's tolerant consistency must exceed
+# chance by this to merge on its walls.
+LEADS = [0.0, 0.02, 0.04]
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
@@ -133,27 +137,28 @@ def main():
                 judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
                 if judged:
                     tops[key] = max(judged, key=lambda r: scores[id(r)])
-            for k in RUNNER_UP:
-                for floor in FLOORS:
-                    def value(top):
-                        s = scores[id(top)]
-                        rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
-                        return s + k * (s - rival)
-                    values = {key: value(top) for key, top in tops.items()}
-                    wrong = [v for key, v in values.items() if not tops[key]["right"] and not tops[key]["near"]]
-                    threshold = max(wrong) + MARGIN
-                    merged_right = sum(1 for key in positives
-                                       if key in tops and tops[key]["right"] and values[key] >= threshold)
-                    live_right = sum(1 for key in live
-                                     if key in tops and tops[key]["right"] and values[key] >= threshold)
-                    print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f}: "
-                          f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
-                          f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
-                    rank = (merged_right, -k, w, e, floor)
-                    if best is None or rank > best[0]:
-                        best = (rank, w, e, k, floor, threshold, merged_right, live_right)
-    _, w, e, k, floor, threshold, merged_right, live_right = best
-    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
+            for k, floor, lead in itertools.product(RUNNER_UP, FLOORS, LEADS):
+                def value(top):
+                    s = scores[id(top)]
+                    rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
+                    return s + k * (s - rival)
+                # A top not leading chance by `lead` cannot merge: below any threshold.
+                values = {key: value(top) if top["T"] - top["C"] >= lead else -math.inf
+                          for key, top in tops.items()}
+                wrong = [v for key, v in values.items() if not tops[key]["right"] and not tops[key]["near"]]
+                threshold = max(wrong) + MARGIN
+                merged_right = sum(1 for key in positives
+                                   if key in tops and tops[key]["right"] and values[key] >= threshold)
+                live_right = sum(1 for key in live
+                                 if key in tops and tops[key]["right"] and values[key] >= threshold)
+                print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f}: "
+                      f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
+                      f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
+                rank = (merged_right, -k, w, e, floor, -lead)
+                if best is None or rank > best[0]:
+                    best = (rank, w, e, k, floor, lead, threshold, merged_right, live_right)
+    _, w, e, k, floor, lead, threshold, merged_right, live_right = best
+    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "

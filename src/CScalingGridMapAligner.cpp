@@ -60,6 +60,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_chance_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_min_lead, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_floor, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(distinct_shift, double, c, s);
@@ -105,6 +106,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
 	in("decision_chance_weight", decision_chance_weight, 0, 10);
 	in("decision_evidence", decision_evidence, 0, 1e6);
+	in("decision_min_lead", decision_min_lead, -1, 1);
 	in("decision_runner_up_weight", decision_runner_up_weight, 0, 100);
 	in("decision_runner_up_floor", decision_runner_up_floor, -10, 10);
 	in("distinct_shift", distinct_shift, 1, 1e4);
@@ -146,6 +148,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = T + w (T - chance T) - sqrt(evidence / judged)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_lead, "Merged on its walls only if they agree more than chance by this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_weight, "Decision value = best score + w (it - best distinct rival's score)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_floor, "A rival scoring below this counts as this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(distinct_shift, "Candidates this far apart are rivals [coarse cells]");
@@ -673,9 +676,13 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// confidence (a rival scores at most as much, so the decision value is at
 	// least the score; one scoring more would itself be merged). Searching on
 	// is then only time: independent maps never get there (calibration data).
+	auto leadsChance = [&](const TCandidate& c) {
+		return c.tolerant_consistency - c.chance_consistency >= options.decision_min_lead;
+	};
 	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
 		return c.exact_confidence >= exact_needed ||
 			(!c.screened && c.judged_points >= kMinJudgedPoints && c.score >= options.decision_runner_up_floor &&
+			 leadsChance(c) &&
 			 confidenceOfValue(c.score) >= std::max(0.5, options.min_confidence));
 	};
 	// Two ways to be sure: the maps coincide cell for cell (a candidate's
@@ -702,7 +709,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					c.runner_up_score = std::max(c.runner_up_score, o.score);
 			c.decision_value =
 				c.score + options.decision_runner_up_weight * (c.score - c.runner_up_score);
-			c.confidence = std::max(c.confidence, confidenceOfValue(c.decision_value));
+			if (leadsChance(c)) c.confidence = std::max(c.confidence, confidenceOfValue(c.decision_value));
 		}
 		std::optional<size_t> chosen;
 		for (size_t i = 0; i < cands.size(); ++i)
@@ -883,6 +890,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (std::isfinite(info.decision_value))
 			why << ", score " << info.score << " against " << info.runner_up_score << " for the best rival (decision value "
 				<< info.decision_value << ", " << options.decision_threshold << " needed)";
+		if (std::isfinite(info.decision_value) && info.consistency - info.chance_consistency < options.decision_min_lead)
+			why << ", walls agreeing no more than chance (less than decision_min_lead = " << options.decision_min_lead
+				<< " above it)";
 		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
 		if (info.mirror_score > info.score)
 			why << "; the other map fits better mirrored (score " << info.mirror_score

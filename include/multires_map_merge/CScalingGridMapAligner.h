@@ -110,6 +110,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 1000;
+		/** The best candidate merges on its walls only if they agree more
+		 * than chance by at least this (tolerant consistency − chance): two
+		 * buildings whose walls agree about as well anywhere (a small map
+		 * against a large one of another building) prove nothing, however
+		 * few rivals they have. */
+		double decision_min_lead = 0.02;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
@@ -124,7 +130,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.753;
+		double decision_threshold = 0.535;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
