@@ -782,7 +782,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << one.r.transform << " xi "
 								  << one.r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
 								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
-								  << cand.score << (cand.converged_on_exact ? " (on an exact candidate)" : cand.screened ? " (screened)" : "") << " exact conf "
+								  << cand.score
+								  << (cand.converged_on_exact ? " (on an exact candidate)" : cand.screened ? " (screened)" : "")
+								  << " exact conf "
 								  << cand.exact_confidence);
 				if (mergedWhateverComes(cand, 0.95) && !options.exhaustive_search) stop = true;
 				if (!cand.screened && cand.exact_confidence >= options.min_confidence) exact_found.push_back(cand);
