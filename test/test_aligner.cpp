@@ -330,6 +330,26 @@ TEST(Carmen, HundredEightyBeamScansSpanHalfACircle)
 	expectAccurate(pair, aligner.alignScaled(pair.ref, pair.other));
 }
 
+// A robot that has seen little of one building against the whole of
+// another: walls agree about as well at the best placement as anywhere, and
+// with no rival the lead over the floor alone would merge it. Refused
+// because its walls do not lead chance (decision_min_lead).
+TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
+{
+	MMM_REQUIRE_SHARED(fr079, "carmen_corrected/freiburg-079-corrected.log.gz");
+	MMM_REQUIRE_SHARED(orebro, "carmen_corrected/orebro-corrected.log.gz");
+	const ScanSequence &a = scansOf(fr079), &b = scansOf(orebro);
+	const auto ref = renderGrid(a, 0, a.size(), 0.08), other = renderGrid(b, 0, b.size() * 15 / 100, 0.05);
+	CScalingGridMapAligner gated, ungated;
+	ungated.options.decision_min_lead = 0;
+	const auto r = gated.alignScaled(ref, other), u = ungated.alignScaled(ref, other);
+	EXPECT_FALSE(r.success) << r.message;
+	EXPECT_LT(r.consistency - r.chance_consistency, gated.options.decision_min_lead);
+	EXPECT_NE(r.message.find("no more than chance"), std::string::npos) << r.message;
+	// What the gate refuses: the same candidate, merged on its lead alone.
+	EXPECT_TRUE(u.success) << u.message;
+}
+
 TEST(Decision, RealMapsOfDifferentBuildingsFromTheSharedDataAreNeverMerged)
 {
 	// The confidence bar, checked on real negatives at mixed resolutions
