@@ -159,12 +159,32 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(max_map_cells, "Larger maps are refused (bounds peak memory)");
 }
 
+namespace
+{
+/** Whether two placements of the other map (its transform into the
+ * reference's cells and where its wall centroid lands) are within `cells`
+ * coarse cells at the centroid, `turn_deg` and `log_scale` of each other. */
+bool samePlacement(
+	const Similarity2D& a, const Eigen::Vector2d& a_centre, const Similarity2D& b, const Eigen::Vector2d& b_centre,
+	double cells, double turn_deg, double log_scale)
+{
+	const double coarse = std::max({1.0, a.scale, b.scale});
+	return (a_centre - b_centre).norm() <= cells * coarse &&
+		std::abs(std::remainder(a.yaw - b.yaw, 2 * M_PI)) <= turn_deg * M_PI / 180 &&
+		std::abs(std::log(a.scale / b.scale)) <= log_scale;
+}
+}  // namespace
+
 bool CScalingGridMapAligner::areRivals(const TCandidate& a, const TCandidate& b) const
 {
-	const double coarse = std::max({1.0, a.cells.scale, b.cells.scale});
-	const double turn = std::abs(std::remainder(a.cells.yaw - b.cells.yaw, 2 * M_PI));
-	return (a.other_centre - b.other_centre).norm() > options.distinct_shift * coarse ||
-		turn > options.verify_turn_deg * M_PI / 180 || std::abs(std::log(a.cells.scale / b.cells.scale)) > std::log(1.1);
+	return !samePlacement(
+		a.cells, a.other_centre, b.cells, b.other_centre, options.distinct_shift, options.verify_turn_deg,
+		std::log(1.1));
+}
+
+bool CScalingGridMapAligner::TConfigParams::leadsChance(double tolerant_consistency, double chance_consistency) const
+{
+	return tolerant_consistency - chance_consistency >= decision_min_lead;
 }
 
 double CScalingGridMapAligner::TConfigParams::lowestMergeableScore() const
@@ -585,10 +605,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	auto onExactFound = [&](const Similarity2D& t) {
 		const Eigen::Vector2d centre = t.apply(other_centroid);
 		return std::any_of(exact_found.begin(), exact_found.end(), [&](const TCandidate& c) {
-			const double coarse = std::max({1.0, t.scale, c.cells.scale});
-			return (centre - c.other_centre).norm() <= kSamePlacementCells * coarse &&
-				std::abs(std::remainder(t.yaw - c.cells.yaw, 2 * M_PI)) <= kSamePlacementTurnDeg * M_PI / 180 &&
-				std::abs(std::log(t.scale / c.cells.scale)) <= kSamePlacementScale;
+			return samePlacement(
+				t, centre, c.cells, c.other_centre, kSamePlacementCells, kSamePlacementTurnDeg, kSamePlacementScale);
 		});
 	};
 	auto refineOne = [&](const Hypothesis& h) {
@@ -677,7 +695,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// least the score; one scoring more would itself be merged). Searching on
 	// is then only time: independent maps never get there (calibration data).
 	auto leadsChance = [&](const TCandidate& c) {
-		return c.tolerant_consistency - c.chance_consistency >= options.decision_min_lead;
+		return options.leadsChance(c.tolerant_consistency, c.chance_consistency);
 	};
 	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
 		return c.exact_confidence >= exact_needed ||
@@ -892,7 +910,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (std::isfinite(info.decision_value))
 			why << ", score " << info.score << " against " << info.runner_up_score << " for the best rival (decision value "
 				<< info.decision_value << ", " << options.decision_threshold << " needed)";
-		if (std::isfinite(info.decision_value) && info.consistency - info.chance_consistency < options.decision_min_lead)
+		if (std::isfinite(info.decision_value) && !options.leadsChance(info.consistency, info.chance_consistency))
 			why << ", walls agreeing no more than chance (less than decision_min_lead = " << options.decision_min_lead
 				<< " above it)";
 		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";

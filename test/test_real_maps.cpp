@@ -150,7 +150,7 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 
 	// Against its own mirror image the map's symmetries fit well enough to
 	// merge on the walls alone (its decision value, about 0.86, is above the
-	// default threshold 0.753 too; the test sets 0.7 to not hang on that);
+	// default threshold too; the test sets 0.7 to not hang on that);
 	// the mirror check sees that the map fits itself better mirrored, refuses,
 	// and says why.
 	const GridInFrame original = loadGridMap(halmstad()->yaml("E5_01", dir()));

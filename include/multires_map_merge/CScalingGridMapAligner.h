@@ -160,6 +160,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double relevantScore(double best_score) const;
 		/** Decision value per unit of confidence: 0.2 (1 + runner-up weight). */
 		double valuePerConfidence() const;
+		/** Walls agreeing this well (tolerant consistency) against chance
+		 * may merge on them: they lead chance by decision_min_lead. */
+		bool leadsChance(double tolerant_consistency, double chance_consistency) const;
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
