@@ -215,3 +215,22 @@ TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 			std::abs(wrapToPi(h.other_to_ref.yaw + turn.yaw)) < 4 * M_PI / 180;
 	EXPECT_TRUE(found) << "no hypothesis near scale 1.6, yaw -117°";
 }
+
+TEST(StructureHypotheses, PlaceAMapByItsKnownPartWherever)
+{
+	// The search runs on each map's known part (the rest is unexplored
+	// margin): a map moved deep into a larger canvas of unknown cells must
+	// come back to the right cells of the whole map, to a few cells (one
+	// working pixel of a map this size is about four cells).
+	const cv::Mat ref = realClasses(0.05);
+	const Similarity2D moved(1.0, 0.0, {310, 170});
+	const cv::Mat other = warpClasses(ref, moved, cv::Size(ref.cols + 400, ref.rows + 300));
+	const auto hyps = structureHypotheses(ref, other);
+	ASSERT_FALSE(hyps.empty());
+	const Similarity2D truth = moved.inverse();  // other's cells → ref's
+	const Similarity2D& best = hyps.front().other_to_ref;
+	EXPECT_NEAR(best.scale, 1.0, 0.03);
+	EXPECT_NEAR(wrapToPi(best.yaw), 0.0, 2 * M_PI / 180);
+	for (const Eigen::Vector2d& corner : {Eigen::Vector2d(310, 170), Eigen::Vector2d(310 + ref.cols, 170 + ref.rows)})
+		EXPECT_LT((best(corner) - truth(corner)).norm(), 12.0) << "corner " << corner.transpose();
+}
