@@ -463,7 +463,24 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::mirrored(const TP
 	p->feature_params = map.feature_params;
 	p->cell_to_metric = map.cell_to_metric;  // not a frame: only cells are compared
 	cv::flip(map.classes, p->classes, 1);
-	describe(*p);
+	// SIFT is not mirror-symmetric: the features anew, on another thread
+	// (one map here, not two at once). The edges and the field are the map's
+	// own mirrored: the same as computed on the flipped map (the exact
+	// distance transform is symmetric; the points in the scan order
+	// edgePoints gives), without computing them.
+	auto features = std::async(
+		std::launch::async, [&]() { return extractPyramidFeatures(p->classes, p->feature_params); });
+	const double last_x = map.classes.cols - 1;
+	p->edges.reserve(map.edges.size());
+	for (const auto& e : map.edges) p->edges.emplace_back(last_x - e.x(), e.y());
+	std::sort(p->edges.begin(), p->edges.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+		return a.y() < b.y() || (a.y() == b.y() && a.x() < b.x());
+	});
+	if (p->edges.size() >= 3) p->edge_tree = std::make_shared<const PointKDTree>(p->edges);
+	cv::flip(map.field.dist_to_occupied, p->field.dist_to_occupied, 1);
+	cv::flip(map.field.dist_to_not_free, p->field.dist_to_not_free, 1);
+	cv::flip(map.field.known, p->field.known, 1);
+	p->features = features.get();
 	return p;
 }
 
