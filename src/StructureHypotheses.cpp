@@ -68,14 +68,15 @@ double dominantWallDirection(const cv::Mat& classes)
 namespace
 {
 /** The correlation peaks (`peaks` per pose; pose = scale index × 4 +
- * right-angle turn) between the two wall masks resampled by `f_ref` and
- * `f_other`; empty where a pose was skipped (the whole other map, of
- * `other_whole` cells, would not fit three working sizes). */
+ * right-angle turn), with both maps at most `working_size` across; empty
+ * where a pose was skipped. */
 std::vector<std::vector<Scored>> searchPoses(
-	const cv::Mat& ref_occupied, const cv::Mat& other_occupied, double f_ref, double f_other,
-	const cv::Size& other_whole, int working_size, const std::vector<double>& scales, double turn, int peaks)
+	const cv::Mat& ref_occupied, const cv::Mat& other_occupied, int working_size, const std::vector<double>& scales,
+	double turn, int peaks)
 {
 	std::vector<std::vector<Scored>> found_per_pose(scales.size() * 4);
+	const double f_ref = fitFactor(ref_occupied, working_size);
+	const double f_other = fitFactor(other_occupied, working_size);
 	const cv::Mat a = wallImage(ref_occupied, f_ref), b0 = wallImage(other_occupied, f_other);
 	if (cv::sum(a)[0] <= 0 || cv::sum(b0.mul(b0))[0] <= 0) return found_per_pose;
 	const Similarity2D other_down = resampling(f_other);
@@ -105,24 +106,22 @@ std::vector<std::vector<Scored>> searchPoses(
 			const int k = pose % 4;
 			std::vector<Scored>& found = found_per_pose[pose];
 			// Other's working image → ref's working image, up to a translation.
-			auto placedSize = [&](const Similarity2D& lin, double cols, double rows) {
+			auto placedSize = [&](const Similarity2D& lin) {
 				Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
-				for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(cols, 0),
-												 Eigen::Vector2d(0, rows), Eigen::Vector2d(cols, rows)})
+				for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b0.cols, 0),
+												 Eigen::Vector2d(0, b0.rows), Eigen::Vector2d(b0.cols, b0.rows)})
 					lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
 				return std::pair{lo, hi};
 			};
 			{
-				// The poses searched: those whose whole other map fits three
-				// working sizes at the reference's working size (as before the
-				// shrink and the crop).
-				const auto [lo, hi] = placedSize(
-					Similarity2D(s * f_ref, turn + k * M_PI / 2, {0, 0}), other_whole.width, other_whole.height);
+				// The poses searched: those whose other map fits three working
+				// sizes at the reference's working size (as before the shrink).
+				const auto [lo, hi] = placedSize(Similarity2D(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0}));
 				if (hi.x() - lo.x() + 1 > 3 * working_size || hi.y() - lo.y() + 1 > 3 * working_size) continue;
 			}
 			const double f_view = f_ref * std::min(1.0, f_other / (s * f_ref));
 			const Similarity2D lin(s * f_view / f_other, turn + k * M_PI / 2, {0, 0});
-			const auto [lo, hi] = placedSize(lin, b0.cols, b0.rows);
+			const auto [lo, hi] = placedSize(lin);
 			const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
 			if (bw < 8 || bh < 8) continue;
 			const Similarity2D place(lin.scale, lin.yaw, -lo);  // into a bw × bh image
@@ -221,20 +220,10 @@ std::vector<Hypothesis> structureHypotheses(
 			if (std::pow(2.0, double(k) / p.steps_per_octave) >= p.min_scale * 0.9999)
 				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
 	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
-	// Each map's known part only (most of a map can be unexplored margin):
-	// smaller images and DFTs at the working resolution of the whole map.
-	const cv::Rect ref_box = cv::boundingRect(ref_classes != kUnknown);
-	const cv::Rect other_box = cv::boundingRect(other_classes != kUnknown);
-	if (ref_box.empty() || other_box.empty()) return out;
-	const cv::Mat ref_occupied = ref_classes(ref_box) == kOccupied, other_occupied = other_classes(other_box) == kOccupied;
+	const cv::Mat ref_occupied = ref_classes == kOccupied, other_occupied = other_classes == kOccupied;
+	const auto found_per_pose =
+		searchPoses(ref_occupied, other_occupied, p.working_size, scales, turn, p.peaks_per_pose);
 	const double f_ref = fitFactor(ref_classes, p.working_size);
-	auto found_per_pose = searchPoses(
-		ref_occupied, other_occupied, f_ref, fitFactor(other_classes, p.working_size), other_classes.size(),
-		p.working_size, scales, turn, p.peaks_per_pose);
-	// Known part's cells → the whole map's.
-	const Similarity2D ref_from_box(1, 0, {ref_box.x, ref_box.y}), other_to_box(1, 0, {-other_box.x, -other_box.y});
-	for (auto& pose : found_per_pose)
-		for (auto& f : pose) f.other_to_ref = ref_from_box.compose(f.other_to_ref).compose(other_to_box);
 	std::vector<Scored> found;
 	for (const auto& f : found_per_pose) found.insert(found.end(), f.begin(), f.end());
 	std::sort(found.begin(), found.end(), [](const Scored& x, const Scored& y) { return x.score > y.score; });

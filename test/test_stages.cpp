@@ -218,10 +218,9 @@ TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 
 TEST(StructureHypotheses, PlaceAMapByItsKnownPartWherever)
 {
-	// The search runs on each map's known part (the rest is unexplored
-	// margin): a map moved deep into a larger canvas of unknown cells must
-	// come back to the right cells of the whole map, to a few cells (one
-	// working pixel of a map this size is about four cells).
+	// A map moved deep into a larger canvas of unknown cells (unexplored
+	// margin) comes back to the right cells of the whole map, to a few cells
+	// (one working pixel of a map this size is about four cells).
 	const cv::Mat ref = realClasses(0.05);
 	const Similarity2D moved(1.0, 0.0, {310, 170});
 	const cv::Mat other = warpClasses(ref, moved, cv::Size(ref.cols + 400, ref.rows + 300));
