@@ -442,6 +442,12 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 	return p;
 }
 
+void CScalingGridMapAligner::setEdges(TPreparedMap& p, PointList edges)
+{
+	p.edges = std::move(edges);
+	p.edge_tree = p.edges.size() >= 3 ? std::make_shared<const PointKDTree>(p.edges) : nullptr;
+}
+
 void CScalingGridMapAligner::describe(TPreparedMap& p) const
 {
 	mrpt::system::CTicTac stage;
@@ -450,8 +456,7 @@ void CScalingGridMapAligner::describe(TPreparedMap& p) const
 
 	// 2. Edge points, and what the verification judges them against.
 	stage.Tic();
-	p.edges = edgePoints(p.classes);
-	if (p.edges.size() >= 3) p.edge_tree = std::make_shared<const PointKDTree>(p.edges);
+	setEdges(p, edgePoints(p.classes));
 	p.field = occupancyField(p.classes);
 	p.stage_seconds["edges"] += stage.Tac();
 }
@@ -471,12 +476,13 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::mirrored(const TP
 	auto features = std::async(
 		std::launch::async, [&]() { return extractPyramidFeatures(p->classes, p->feature_params); });
 	const double last_x = map.classes.cols - 1;
-	p->edges.reserve(map.edges.size());
-	for (const auto& e : map.edges) p->edges.emplace_back(last_x - e.x(), e.y());
-	std::sort(p->edges.begin(), p->edges.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-		return a.y() < b.y() || (a.y() == b.y() && a.x() < b.x());
+	PointList edges;
+	edges.reserve(map.edges.size());
+	for (const auto& e : map.edges) edges.emplace_back(last_x - e.x(), e.y());
+	std::sort(edges.begin(), edges.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+		return std::pair(a.y(), a.x()) < std::pair(b.y(), b.x());
 	});
-	if (p->edges.size() >= 3) p->edge_tree = std::make_shared<const PointKDTree>(p->edges);
+	setEdges(*p, std::move(edges));
 	cv::flip(map.field.dist_to_occupied, p->field.dist_to_occupied, 1);
 	cv::flip(map.field.dist_to_not_free, p->field.dist_to_not_free, 1);
 	cv::flip(map.field.known, p->field.known, 1);

@@ -216,7 +216,7 @@ TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 	EXPECT_TRUE(found) << "no hypothesis near scale 1.6, yaw -117°";
 }
 
-TEST(StructureHypotheses, PlaceAMapByItsKnownPartWherever)
+TEST(StructureHypotheses, PlaceAMapMovedWithinUnexploredMargin)
 {
 	// A map moved deep into a larger canvas of unknown cells (unexplored
 	// margin) comes back to the right cells of the whole map, to a few cells

@@ -337,6 +337,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
    private:
 	/** Features, edge points and occupancy field of a map's `classes`. */
 	void describe(TPreparedMap& map) const;
+	/** The map's edge points and the k-d tree on them (none below 3 points). */
+	static void setEdges(TPreparedMap& map, PointList edges);
 	/** The map with its x axis flipped, described (mirror_check). */
 	PreparedMapPtr mirrored(const TPreparedMap& map) const;
 	/** With `mirror_pass_relevant`: the search of mirror_check on the
