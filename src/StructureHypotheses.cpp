@@ -84,17 +84,28 @@ std::vector<std::vector<Scored>> searchPoses(
 	// is shrunk instead: the canvas, and with it the DFTs, stay about twice
 	// the working size instead of growing with the scale (most of the time
 	// went there), at the same resolution of the other map's cells.
+	// The reference's walls are kept only within their bounding box (the
+	// rest of a map is often unexplored margin): the correlation is the same,
+	// its DFTs smaller.
 	struct RefView
 	{
 		double f = 0;  //!< ref full cells → this image
-		cv::Mat walls;
+		cv::Mat walls;  //!< within their bounding box ...
+		cv::Point corner;  //!< ... whose corner this is in the whole image
 		bool has_walls = false;  //!< any wall left at this size
 		std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra;  //!< walls and walls², by canvas size
 	};
+	auto makeView = [&](double f, const cv::Mat& whole) {
+		RefView v;
+		v.f = f;
+		const cv::Rect box = cv::boundingRect(whole > 0);
+		v.has_walls = !box.empty();
+		v.walls = v.has_walls ? whole(box) : whole;
+		v.corner = box.tl();
+		return v;
+	};
 	std::map<double, RefView> ref_views;  // by factor
-	ref_views[f_ref].f = f_ref;
-	ref_views[f_ref].walls = a;
-	ref_views[f_ref].has_walls = true;  // checked above
+	ref_views.emplace(f_ref, makeView(f_ref, a));
 	std::mutex spectra_mutex;
 	// The poses (scale × right-angle turn) are independent: searched in
 	// parallel, each keeping its own peaks, gathered in pose order so the
@@ -145,9 +156,7 @@ std::vector<std::vector<Scored>> searchPoses(
 			}
 			if (!view)
 			{
-				RefView made;
-				made.f = f_view, made.walls = wallImage(ref_occupied, f_view);
-				made.has_walls = cv::sum(made.walls)[0] > 0;
+				RefView made = makeView(f_view, wallImage(ref_occupied, f_view));
 				std::lock_guard<std::mutex> lock(spectra_mutex);
 				view = &ref_views.emplace(f_view, std::move(made)).first->second;
 			}
@@ -195,7 +204,9 @@ std::vector<std::vector<Scored>> searchPoses(
 				if (!(best > 0)) break;
 				// Shifts past the middle are negative (the FFT wraps).
 				const double dx = at.x > w - bw ? at.x - w : at.x, dy = at.y > h - bh ? at.y - h : at.y;
-				const Similarity2D working(place.scale, place.yaw, place.t + Eigen::Vector2d(dx, dy));
+				const Similarity2D working(
+					place.scale, place.yaw,
+					place.t + Eigen::Vector2d(dx + view->corner.x, dy + view->corner.y));
 				found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
 				cv::circle(corr, at, 6, cv::Scalar(0), cv::FILLED);
 			}
