@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <tuple>
 #include <opencv2/core/utility.hpp>
 
 namespace multires_map_merge
@@ -93,7 +94,7 @@ std::vector<std::vector<Scored>> searchPoses(
 		cv::Mat walls;  //!< within their bounding box ...
 		cv::Point corner;  //!< ... whose corner this is in the whole image
 		bool has_walls = false;  //!< any wall left at this size
-		std::map<std::pair<int, int>, std::pair<cv::Mat, cv::Mat>> spectra;  //!< walls and walls², by canvas size
+		std::map<std::tuple<int, int, int>, cv::Mat> spectra;  //!< of walls (0) and walls² (1), by canvas size
 	};
 	auto makeView = [&](double f, const cv::Mat& whole) {
 		RefView v;
@@ -162,53 +163,74 @@ std::vector<std::vector<Scored>> searchPoses(
 			}
 			const cv::Mat& a = view->walls;
 			if (!view->has_walls) continue;
-			const int w = cv::getOptimalDFTSize(a.cols + bw), h = cv::getOptimalDFTSize(a.rows + bh);
+			// Two correlations on two canvases: the walls' needs only the other
+			// map's walls (their bounding box), the energy's the whole footprint.
+			const cv::Rect walls_box = cv::boundingRect(b > 0);
+			const cv::Mat other_walls = b(walls_box);
+			auto canvasFor = [&](const cv::Mat& img) {
+				return cv::Size(cv::getOptimalDFTSize(a.cols + img.cols), cv::getOptimalDFTSize(a.rows + img.rows));
+			};
 			// Real images: their spectra packed (CCS), half the work of complex ones.
-			auto spectrum = [&](const cv::Mat& img) {
-				cv::Mat pad = cv::Mat::zeros(h, w, CV_32F), f;
+			auto spectrum = [](const cv::Mat& img, cv::Size canvas) {
+				cv::Mat pad = cv::Mat::zeros(canvas, CV_32F), f;
 				img.copyTo(pad(cv::Rect(0, 0, img.cols, img.rows)));
 				cv::dft(pad, f, 0, img.rows);
 				return f;
 			};
-			auto correlate = [&](const cv::Mat& fx, const cv::Mat& fy) {
+			// The reference's spectra, walls (0) or walls² (1), kept per canvas.
+			auto refSpectrum = [&](int squared, cv::Size canvas) {
+				const std::tuple key{squared, canvas.width, canvas.height};
+				{
+					std::lock_guard<std::mutex> lock(spectra_mutex);
+					if (auto it = view->spectra.find(key); it != view->spectra.end()) return it->second;
+				}
+				cv::Mat made = spectrum(squared ? a.mul(a) : a, canvas);
+				std::lock_guard<std::mutex> lock(spectra_mutex);
+				return view->spectra.emplace(key, std::move(made)).first->second;
+			};
+			// C(i) = Σ a(x)·img(x − i) for every shift i on the canvas (shifts
+			// past the middle are negative: the FFT wraps).
+			auto correlate = [&](int squared, const cv::Mat& img) {
+				const cv::Size canvas = canvasFor(img);
 				cv::Mat prod, c;
-				cv::mulSpectrums(fx, fy, prod, 0, true);
+				cv::mulSpectrums(refSpectrum(squared, canvas), spectrum(img, canvas), prod, 0, true);
 				cv::dft(prod, c, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
 				return c;
 			};
-			cv::Mat fa, fa2;
-			{
-				std::lock_guard<std::mutex> lock(spectra_mutex);
-				if (auto it = view->spectra.find({w, h}); it != view->spectra.end())
-					fa = it->second.first, fa2 = it->second.second;
-			}
-			if (fa.empty())
-			{
-				std::pair<cv::Mat, cv::Mat> made{spectrum(a), spectrum(a.mul(a))};
-				std::lock_guard<std::mutex> lock(spectra_mutex);
-				const auto& kept = view->spectra.emplace(std::make_pair(w, h), std::move(made)).first->second;
-				fa = kept.first, fa2 = kept.second;
-			}
+			auto signedShift = [](int i, int canvas, int img) { return i > canvas - img ? i - canvas : i; };
 			cv::Mat footprint;
 			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
-			cv::Mat corr = correlate(fa, spectrum(b));
-			cv::Mat a_energy = correlate(fa2, spectrum(footprint));
-			cv::max(a_energy, 1e-3 * placed_energy, a_energy);
-			cv::sqrt(a_energy * placed_energy, a_energy);
-			cv::divide(corr, a_energy, corr);
+			cv::Mat corr = correlate(0, other_walls);
+			const cv::Mat a_energy = correlate(1, footprint);
+			// corr at i is the other map placed at i − the walls' corner.
+			std::vector<int> energy_col(corr.cols);
+			for (int i = 0; i < corr.cols; ++i)
+				energy_col[i] = (signedShift(i, corr.cols, other_walls.cols) - walls_box.x + a_energy.cols) % a_energy.cols;
+			for (int r = 0; r < corr.rows; ++r)
+			{
+				const int er = (signedShift(r, corr.rows, other_walls.rows) - walls_box.y + a_energy.rows) % a_energy.rows;
+				const float* e = a_energy.ptr<float>(er);
+				float* c = corr.ptr<float>(r);
+				for (int i = 0; i < corr.cols; ++i)
+					c[i] /= float(std::sqrt(std::max(double(e[energy_col[i]]), 1e-3 * placed_energy) * placed_energy));
+			}
 			for (int peak = 0; peak < peaks; ++peak)
 			{
 				double best;
 				cv::Point at;
 				cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
 				if (!(best > 0)) break;
-				// Shifts past the middle are negative (the FFT wraps).
-				const double dx = at.x > w - bw ? at.x - w : at.x, dy = at.y > h - bh ? at.y - h : at.y;
+				const double dx = signedShift(at.x, corr.cols, other_walls.cols) - walls_box.x,
+							 dy = signedShift(at.y, corr.rows, other_walls.rows) - walls_box.y;
 				const Similarity2D working(
 					place.scale, place.yaw,
 					place.t + Eigen::Vector2d(dx + view->corner.x, dy + view->corner.y));
 				found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
-				cv::circle(corr, at, 6, cv::Scalar(0), cv::FILLED);
+				// The next peak not beside this one, on the wrapped shifts too
+				// (the canvas's seam runs between shifts 0 and -1).
+				for (int ox : {-corr.cols, 0, corr.cols})
+					for (int oy : {-corr.rows, 0, corr.rows})
+						cv::circle(corr, at + cv::Point(ox, oy), 6, cv::Scalar(0), cv::FILLED);
 			}
 		}
 	});
