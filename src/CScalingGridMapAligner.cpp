@@ -695,8 +695,13 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
 		// The first way to be sure (the maps coincide cell for cell) is this
-		// candidate's alone; the second is the pair's (decide, below).
-		cand.exact_confidence = may_be_exact ? exactConfidence(cell_consistency, r.overlap, ip.xi_min, rmse_coarse) : 0.0;
+		// candidate's alone; the second is the pair's (decide, below). Both
+		// need walls enough to judge: a map squeezed into a few cells (TsICP
+		// let the scale collapse to 0.02 on two disjoint parts) agrees with
+		// anything there.
+		cand.exact_confidence = may_be_exact && cand.judged_points >= kMinJudgedPoints
+			? exactConfidence(cell_consistency, r.overlap, ip.xi_min, rmse_coarse)
+			: 0.0;
 		cand.confidence = cand.exact_confidence;
 		out.r = r;
 		out.valid = true;
