@@ -1045,6 +1045,8 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<int> scaling_arg(
 		"", "scaling-only", "only the scaling case of this many cells a side (e.g. 4000)", false, 0, "CELLS", cmd);
 	TCLAP::SwitchArg live_arg("", "live-only", "only the live node's latency (printed as markdown)", cmd);
+	TCLAP::SwitchArg negatives_only_arg(
+		"", "negatives-only", "only the CARMEN pairs that must not merge (different buildings, disjoint parts)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
 	TCLAP::ValueArg<std::string> mrpt_child("", "mrpt-align", "internal: MRPT's aligner in a fresh process", false, "", "REF", cmd);
 	TCLAP::ValueArg<std::string> child_ref("", "scaling-align", "internal: align in a fresh process", false, "", "REF", cmd);
@@ -1112,6 +1114,13 @@ int main(int argc, char** argv)
 		}
 		if (sets_arg.isSet())
 			return runAccuracySets(sets_arg.getValue());
+		if (negatives_only_arg.isSet())
+		{
+			const auto negatives = runCarmenNegatives(quick);
+			const auto merged = std::count_if(negatives.begin(), negatives.end(), [](const Negative& n) { return n.merged; });
+			std::cout << "false merges: " << merged << " / " << negatives.size() << "\n";
+			return merged == 0 ? 0 : 1;
+		}
 		if (live_arg.isSet())
 		{
 			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 4 : 16));
