@@ -110,15 +110,13 @@ std::vector<std::vector<Scored>> searchPoses(
 	std::mutex spectra_mutex;
 	// The poses (scale × right-angle turn) are independent: searched in
 	// parallel, each keeping its own peaks, gathered in pose order so the
-	// result does not depend on the threads. A turn and the one half a turn
-	// further are searched together: the other map's image half a turn on is
-	// its first one flipped, whose correlation is the first one's convolution,
-	// from the same spectra.
-	cv::parallel_for_(cv::Range(0, int(scales.size() * 2)), [&](const cv::Range& range) {
-		for (int task = range.start; task < range.end; ++task)
+	// result does not depend on the threads.
+	cv::parallel_for_(cv::Range(0, int(scales.size() * 4)), [&](const cv::Range& range) {
+		for (int pose = range.start; pose < range.end; ++pose)
 		{
-			const double s = scales[task / 2];
-			const int k = task % 2;  // and k + 2
+			const double s = scales[pose / 4];
+			const int k = pose % 4;
+			std::vector<Scored>& found = found_per_pose[pose];
 			// Other's working image → ref's working image, up to a translation.
 			auto placedSize = [&](const Similarity2D& lin) {
 				Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
@@ -139,8 +137,6 @@ std::vector<std::vector<Scored>> searchPoses(
 			const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
 			if (bw < 8 || bh < 8) continue;
 			const Similarity2D place(lin.scale, lin.yaw, -lo);  // into a bw × bh image
-			// Half a turn on: the image flipped both ways, x → (bw − 1, bh − 1) − x.
-			const Similarity2D place_half_turn(place.scale, place.yaw + M_PI, Eigen::Vector2d(bw - 1, bh - 1) - place.t);
 			const Eigen::Matrix2d l = place.linear();
 			const cv::Mat m = (cv::Mat_<double>(2, 3) << l(0, 0), l(0, 1), place.t.x(), l(1, 0), l(1, 1), place.t.y());
 			cv::Mat b;
@@ -167,12 +163,10 @@ std::vector<std::vector<Scored>> searchPoses(
 			}
 			const cv::Mat& a = view->walls;
 			if (!view->has_walls) continue;
-			// Two canvases: the walls' correlation needs only the other map's
-			// walls (their bounding box), the energy's the whole footprint.
+			// Two correlations on two canvases: the walls' needs only the other
+			// map's walls (their bounding box), the energy's the whole footprint.
 			const cv::Rect walls_box = cv::boundingRect(b > 0);
 			const cv::Mat other_walls = b(walls_box);
-			cv::Mat footprint;
-			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
 			auto canvasFor = [&](const cv::Mat& img) {
 				return cv::Size(cv::getOptimalDFTSize(a.cols + img.cols), cv::getOptimalDFTSize(a.rows + img.rows));
 			};
@@ -194,84 +188,49 @@ std::vector<std::vector<Scored>> searchPoses(
 				std::lock_guard<std::mutex> lock(spectra_mutex);
 				return view->spectra.emplace(key, std::move(made)).first->second;
 			};
-			// Correlation Σ a(x)·img(x − i) (flipped = false) or convolution
-			// Σ a(x)·img(i − x) (true) of the reference with `img`, every i.
-			struct Both
-			{
-				cv::Mat correlation, convolution;
-			};
+			// C(i) = Σ a(x)·img(x − i) for every shift i on the canvas (shifts
+			// past the middle are negative: the FFT wraps).
 			auto correlate = [&](int squared, const cv::Mat& img) {
 				const cv::Size canvas = canvasFor(img);
-				const cv::Mat fa = refSpectrum(squared, canvas), fi = spectrum(img, canvas);
-				Both out;
-				for (const bool conj : {true, false})
-				{
-					cv::Mat prod;
-					cv::mulSpectrums(fa, fi, prod, 0, conj);
-					cv::dft(prod, conj ? out.correlation : out.convolution,
-							cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-				}
-				return out;
+				cv::Mat prod, c;
+				cv::mulSpectrums(refSpectrum(squared, canvas), spectrum(img, canvas), prod, 0, true);
+				cv::dft(prod, c, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+				return c;
 			};
-			Both walls = correlate(0, other_walls);
-			const Both energy = correlate(1, footprint);
-			// Each canvas column (row) as the shift d of the placed image and
-			// the energy's column (row) at d, -1 where outside its canvas.
-			struct Axis
+			auto signedShift = [](int i, int canvas, int img) { return i > canvas - img ? i - canvas : i; };
+			cv::Mat footprint;
+			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
+			cv::Mat corr = correlate(0, other_walls);
+			const cv::Mat a_energy = correlate(1, footprint);
+			// corr at i is the other map placed at i − the walls' corner.
+			std::vector<int> energy_col(corr.cols);
+			for (int i = 0; i < corr.cols; ++i)
+				energy_col[i] = (signedShift(i, corr.cols, other_walls.cols) - walls_box.x + a_energy.cols) % a_energy.cols;
+			for (int r = 0; r < corr.rows; ++r)
 			{
-				std::vector<int> shift, energy_index;
-			};
-			auto axis = [&](int canvas, int walls_size, int walls_corner, int placed_size, int energy_canvas, bool half_turn) {
-				Axis out;
-				for (int i = 0; i < canvas; ++i)
-				{
-					// Shifts past the middle of a correlation are negative (the FFT
-					// wraps); the convolution at i is the flipped image at
-					// i − (placed_size − 1 − walls_corner), its energy at i + walls_corner.
-					const int d = half_turn ? i - (placed_size - 1 - walls_corner)
-											: (i > canvas - walls_size ? i - canvas : i) - walls_corner;
-					const int e = half_turn ? i + walls_corner : (d + energy_canvas) % energy_canvas;
-					out.shift.push_back(d);
-					out.energy_index.push_back(e < energy_canvas ? e : -1);
-				}
-				return out;
-			};
-			for (const bool half_turn : {false, true})
+				const int er = (signedShift(r, corr.rows, other_walls.rows) - walls_box.y + a_energy.rows) % a_energy.rows;
+				const float* e = a_energy.ptr<float>(er);
+				float* c = corr.ptr<float>(r);
+				for (int i = 0; i < corr.cols; ++i)
+					c[i] /= float(std::sqrt(std::max(double(e[energy_col[i]]), 1e-3 * placed_energy) * placed_energy));
+			}
+			for (int peak = 0; peak < peaks; ++peak)
 			{
-				cv::Mat& corr = half_turn ? walls.convolution : walls.correlation;
-				const cv::Mat& e = half_turn ? energy.convolution : energy.correlation;
-				const Axis cols = axis(corr.cols, other_walls.cols, walls_box.x, bw, e.cols, half_turn);
-				const Axis rows = axis(corr.rows, other_walls.rows, walls_box.y, bh, e.rows, half_turn);
-				for (int r = 0; r < corr.rows; ++r)
-				{
-					float* c = corr.ptr<float>(r);
-					const int er = rows.energy_index[r];
-					for (int i = 0; i < corr.cols; ++i)
-					{
-						const int ec = cols.energy_index[i];
-						c[i] = er < 0 || ec < 0 ? 0.0f
-												: float(c[i] / std::sqrt(std::max(double(e.at<float>(er, ec)), 1e-3 * placed_energy) *
-																		 placed_energy));
-					}
-				}
-				const Similarity2D& placed = half_turn ? place_half_turn : place;
-				std::vector<Scored>& found = found_per_pose[size_t(task / 2) * 4 + size_t(k + (half_turn ? 2 : 0))];
-				for (int peak = 0; peak < peaks; ++peak)
-				{
-					double best;
-					cv::Point at;
-					cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
-					if (!(best > 0)) break;
-					const Similarity2D working(
-						placed.scale, placed.yaw,
-						placed.t + Eigen::Vector2d(cols.shift[at.x] + view->corner.x, rows.shift[at.y] + view->corner.y));
-					found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
-					// The next peak not beside this one, on the wrapped shifts too
-					// (a correlation's seam runs between shifts 0 and -1).
-					for (int ox : {-corr.cols, 0, corr.cols})
-						for (int oy : {-corr.rows, 0, corr.rows})
-							cv::circle(corr, at + cv::Point(ox, oy), 6, cv::Scalar(0), cv::FILLED);
-				}
+				double best;
+				cv::Point at;
+				cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
+				if (!(best > 0)) break;
+				const double dx = signedShift(at.x, corr.cols, other_walls.cols) - walls_box.x,
+							 dy = signedShift(at.y, corr.rows, other_walls.rows) - walls_box.y;
+				const Similarity2D working(
+					place.scale, place.yaw,
+					place.t + Eigen::Vector2d(dx + view->corner.x, dy + view->corner.y));
+				found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
+				// The next peak not beside this one, on the wrapped shifts too
+				// (the canvas's seam runs between shifts 0 and -1).
+				for (int ox : {-corr.cols, 0, corr.cols})
+					for (int oy : {-corr.rows, 0, corr.rows})
+						cv::circle(corr, at + cv::Point(ox, oy), 6, cv::Scalar(0), cv::FILLED);
 			}
 		}
 	});
