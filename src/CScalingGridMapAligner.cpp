@@ -632,49 +632,72 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 				t, centre, c.cells, c.other_centre, kSamePlacementCells, kSamePlacementTurnDeg, kSamePlacementScale);
 		});
 	};
-	auto refineOne = [&](const Hypothesis& h) {
-		Refined out;
+	// The cheap verification of a hypothesis (screen_points): TsICP on a
+	// sample of the fixed set, judged on samples. It needs nothing of the
+	// other hypotheses, so screens run ahead of the refinements they gate.
+	struct Screen
+	{
+		bool ran = false;  //!< screen_points > 0
+		bool valid = false;  //!< a finite transform at the scale allowed
+		TsICPResult quick;
+		TwoWaySupport sup;
+		Chance chance;
+		double score = 0, rmse_coarse = 0;
+		bool may_be_exact = false;
+		double icp_s = 0, verify_s = 0;
+	};
+	auto screenOne = [&](const Hypothesis& h) {
+		Screen s;
+		if (options.screen_points <= 0) return s;
+		s.ran = true;
 		mrpt::system::CTicTac clock;
-		// Cheap first (screen_points): TsICP on a sample of the fixed set,
-		// judged on samples; a hypothesis that cannot come near a merge there
-		// is not refined on every point nor judged in full.
-		Similarity2D full_start = h.other_to_ref;
-		if (options.screen_points > 0)
+		s.quick = refineFromTheInside(ref, other, h.other_to_ref, ip, size_t(options.screen_points));
+		s.icp_s = clock.Tac();
+		if (!s.quick.transform.isFinite() || !(s.quick.transform.scale > 0) || !scaleAsStated(s.quick.transform))
+			return s;
+		clock.Tic();
+		s.score = decisionScore(s.quick.transform, size_t(options.screen_points), s.sup, s.chance);
+		s.verify_s = clock.Tac();
+		s.rmse_coarse = std::sqrt(s.quick.trimmed_mse) / std::max(1.0, s.quick.transform.scale);
+		MRPT_LOG_DEBUG_STREAM(
+			"screen " << h.other_to_ref << " -> " << s.quick.transform << " rmse " << s.rmse_coarse
+					  << " tolerant consistency " << s.sup.consistency() << " chance " << s.chance.consistency
+					  << " score " << s.score);
+		// Only where neither way to be sure (below) is near: the maps are
+		// not the same cells, and their walls agree too little.
+		s.may_be_exact = s.rmse_coarse < kExactMaxRmse && s.sup.consistency() > kExactMinScreenConsistency;
+		s.valid = true;
+		return s;
+	};
+	// A screened hypothesis goes no further when it cannot come near a merge
+	// (below the screen's bar: it is not refined on every point nor judged in
+	// full) or it landed on a candidate found to coincide cell for cell.
+	auto convergedOnExact = [&](const Screen& s) {
+		return s.valid && !options.exhaustive_search && onExactFound(s.quick.transform);
+	};
+	auto stopsAtScreen = [&](const Screen& s) {
+		return s.ran && (!s.valid || (!s.may_be_exact && s.score < screen_bar) || convergedOnExact(s));
+	};
+	auto refineOne = [&](const Hypothesis& h, const Screen& s) {
+		Refined out;
+		out.icp_s = s.icp_s, out.verify_s = s.verify_s;
+		if (s.ran && !s.valid) return out;
+		if (stopsAtScreen(s))
 		{
-			const TsICPResult quick = refineFromTheInside(ref, other, h.other_to_ref, ip, size_t(options.screen_points));
-			out.icp_s = clock.Tac();
-			if (!quick.transform.isFinite() || !(quick.transform.scale > 0) || !scaleAsStated(quick.transform))
-				return out;
-			clock.Tic();
-			TwoWaySupport sup;
-			Chance chance;
-			const double score = decisionScore(quick.transform, size_t(options.screen_points), sup, chance);
-			out.verify_s = clock.Tac();
-			const double rmse_coarse = std::sqrt(quick.trimmed_mse) / std::max(1.0, quick.transform.scale);
-			MRPT_LOG_DEBUG_STREAM(
-				"screen " << h.other_to_ref << " -> " << quick.transform << " rmse " << rmse_coarse << " tolerant consistency "
-						  << sup.consistency() << " chance " << chance.consistency << " score " << score);
-			// Only where neither way to be sure (below) is near: the maps are
-			// not the same cells, and their walls agree too little.
-			const bool may_be_exact = rmse_coarse < kExactMaxRmse && sup.consistency() > kExactMinScreenConsistency;
-			const bool converged_on_exact = !options.exhaustive_search && onExactFound(quick.transform);
-			if ((!may_be_exact && score < screen_bar) || converged_on_exact)
-			{
-				out.cand = candidate(h, quick, rmse_coarse, std::numeric_limits<double>::quiet_NaN(), sup, chance, score);
-				out.cand.screened = true;
-				out.cand.converged_on_exact = converged_on_exact;
-				out.r = quick;
-				out.valid = true;
-				return out;
-			}
-			// Independent maps: refined on every point from the sample's
-			// result (fewer iterations; the same optimum to a fraction of a
-			// cell). Where the maps may coincide cell for cell, from the
-			// hypothesis, as without the screen: converged from a sample,
-			// TsICP stops a few hundredths of a cell short of exact.
-			if (!may_be_exact) full_start = quick.transform;
-			clock.Tic();
+			out.cand = candidate(h, s.quick, s.rmse_coarse, std::numeric_limits<double>::quiet_NaN(), s.sup, s.chance, s.score);
+			out.cand.screened = true;
+			out.cand.converged_on_exact = convergedOnExact(s);
+			out.r = s.quick;
+			out.valid = true;
+			return out;
 		}
+		// Independent maps: refined on every point from the sample's result
+		// (fewer iterations; the same optimum to within a cell). Where the
+		// maps may coincide cell for cell, from the hypothesis, as without the
+		// screen: converged from a sample, TsICP stops a few hundredths of a
+		// cell short of exact.
+		const Similarity2D full_start = s.ran && !s.may_be_exact ? s.quick.transform : h.other_to_ref;
+		mrpt::system::CTicTac clock;
 		const TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
 		out.icp_s += clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0) || !scaleAsStated(r.transform)) return out;
@@ -799,25 +822,50 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return std::max(least_relevant, options.relevantScore(bestScore())) - options.screen_margin;
 	};
 	// Refined a few at a time (one per thread), judged in order: the result
-	// is the sequential one, at most a batch's tail computed in vain when a
+	// is the sequential one, at most a round's tail computed in vain when a
 	// candidate is merged whatever comes (the maps coincide cell for cell
 	// with confidence 0.95, so no other hypothesis can do meaningfully
-	// better, or its score alone reaches the threshold).
+	// better, or its score alone reaches the threshold). A round takes the
+	// hypotheses in order until one per thread needs refining on every point,
+	// their screens run ahead, one per thread at a time: the threads refine
+	// together instead of one waiting while the other screens.
 	auto refineAll = [&](const std::vector<Hypothesis>& list) {
 		const size_t n = std::min<size_t>(list.size(), size_t(std::max(0, options.max_hypotheses)));
-		const size_t batch = size_t(std::clamp(cv::getNumThreads(), 1, 4));
+		const size_t threads = size_t(std::clamp(cv::getNumThreads(), 1, 4));
+		std::vector<Screen> screens(n);
+		size_t screened_up_to = 0;
 		bool stop = false;
-		for (size_t first = 0; first < n && !stop; first += batch)
+		for (size_t first = 0; first < n && !stop;)
 		{
 			if (!options.exhaustive_search) screen_bar = screenBar();
-			std::vector<Refined> done(std::min(batch, n - first));
-			cv::parallel_for_(cv::Range(0, int(done.size())), [&](const cv::Range& range) {
-				for (int j = range.start; j < range.end; ++j) done[j] = refineOne(list[first + j]);
-			});
-			for (size_t j = 0; j < done.size(); ++j)
+			std::vector<size_t> in_full;  // hypotheses of this round refined on every point
+			size_t end = first;
+			while (end < n && in_full.size() < threads)
 			{
-				const Hypothesis& h = list[first + j];
-				const Refined& one = done[j];
+				if (end == screened_up_to)
+				{
+					const size_t upto = std::min(n, screened_up_to + threads);
+					cv::parallel_for_(cv::Range(int(screened_up_to), int(upto)), [&](const cv::Range& range) {
+						for (int j = range.start; j < range.end; ++j) screens[j] = screenOne(list[j]);
+					});
+					screened_up_to = upto;
+				}
+				if (!stopsAtScreen(screens[end])) in_full.push_back(end);
+				++end;
+			}
+			std::vector<Refined> done(end - first);
+			if (!in_full.empty())
+				cv::parallel_for_(cv::Range(0, int(in_full.size())), [&](const cv::Range& range) {
+					for (int k = range.start; k < range.end; ++k)
+						done[in_full[k] - first] = refineOne(list[in_full[k]], screens[in_full[k]]);
+				});
+			for (size_t j = first; j < end; ++j)
+				if (std::find(in_full.begin(), in_full.end(), j) == in_full.end())
+					done[j - first] = refineOne(list[j], screens[j]);  // stops at its screen
+			for (size_t j = first; j < end; ++j)
+			{
+				const Hypothesis& h = list[j];
+				const Refined& one = done[j - first];
 				++info.hypotheses_refined;
 				icp_s += one.icp_s, verify_s += one.verify_s;
 				if (!one.valid) continue;
@@ -835,6 +883,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 				if (mergedWhateverComes(cand, 0.95) && !options.exhaustive_search) stop = true;
 				if (!cand.screened && cand.exact_confidence >= options.min_confidence) exact_found.push_back(cand);
 			}
+			first = end;
 		}
 		decide();
 	};
