@@ -1044,7 +1044,8 @@ int main(int argc, char** argv)
 	TCLAP::SwitchArg fleet_arg("", "fleet-only", "only the fleet section (printed as markdown)", cmd);
 	TCLAP::ValueArg<int> scaling_arg(
 		"", "scaling-only", "only the scaling case of this many cells a side (e.g. 4000)", false, 0, "CELLS", cmd);
-	TCLAP::SwitchArg live_arg("", "live-only", "only the live node's latency (printed as markdown)", cmd);
+	TCLAP::SwitchArg live_arg(
+		"", "live-only", "only the live node's latency (printed as markdown); exit 1 if a robot was ever placed wrong", cmd);
 	TCLAP::SwitchArg negatives_only_arg(
 		"", "negatives-only", "only the CARMEN pairs that must not merge (different buildings, disjoint parts)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
@@ -1123,8 +1124,13 @@ int main(int argc, char** argv)
 		}
 		if (live_arg.isSet())
 		{
-			writeLiveSection(std::cout, runLiveLatency(scansOf, quick ? 4 : 16));
-			return 0;
+			const LiveLatency live = runLiveLatency(scansOf, quick ? 4 : 16);
+			writeLiveSection(std::cout, live);
+			// Exit 1 when a robot was ever placed wrong (the other building at
+			// all); its latency depends on this machine's speed and is only shown.
+			const bool never_wrong = std::none_of(
+				live.robots.begin(), live.robots.end(), [](const LiveRobotRow& r) { return r.wrong_estimations > 0; });
+			return never_wrong ? 0 : 1;
 		}
 		if (scaling_arg.isSet())
 		{
