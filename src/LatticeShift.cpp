@@ -50,7 +50,13 @@ Eigen::Vector2d latticeShift(
 	double half = p.range, step = std::max(finest, p.range / 10);
 	for (int pass = 0; pass < 2; ++pass)
 	{
-		const int n = int(std::round(half / step));
+		int n = int(std::round(half / step));
+		// A shift of exactly half a cell is where the points round either
+		// way: which way depends on their last bit (and the machine), and a
+		// plateau ending there one-sidedly moves its centre (identical maps
+		// came out a fortieth of a cell off). The whole range's pass stops a
+		// step short of it; the next pass still reaches past it.
+		if (pass == 0 && n > 1) --n;
 		const int side = 2 * n + 1;
 		std::vector<size_t> cost(size_t(side) * side);
 		cv::parallel_for_(cv::Range(0, side * side), [&](const cv::Range& r) {

@@ -363,6 +363,26 @@ TEST(MapFrames, LatticeShiftUndoesASubCellErrorOnARealCoarseMap)
 	}
 }
 
+TEST(MapFrames, LatticeShiftOfAMapOnItselfIsZeroWhicheverWayItsPointsRound)
+{
+	// A map's own occupied cells on its own lattice need no shift. Their
+	// coordinates come out of a transform a last bit above or below the
+	// integers (which way depends on the machine): the half-cell boundary
+	// must not tip the plateau's centre either way (it did, by 0.025 cells).
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const ScanSequence& s = *fr079();
+	const cv::Mat classes = toClassImage(renderGrid(s, 0, s.size(), 0.10));
+	const PointList occupied = occupiedPoints(classes);
+	const cv::Mat near_known = knownWithin(classes != kUnknown, 2);
+	for (const double bit : {1e-12, -1e-12})
+		for (const Eigen::Vector2d& dir : {Eigen::Vector2d(1, 1), Eigen::Vector2d(1, -1)})
+		{
+			PointList nudged;
+			for (const auto& p : occupied) nudged.push_back(p + bit * dir);
+			EXPECT_LT(latticeShift(nudged, occupied, near_known).norm(), 1e-9) << "nudged by " << (bit * dir).transpose();
+		}
+}
+
 TEST(MapFrames, RotatedYamlOriginGivesTheUnrotatedTransformReexpressed)
 {
 	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
