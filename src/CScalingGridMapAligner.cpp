@@ -602,6 +602,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.tolerant_consistency = sup.consistency();
 		c.chance_consistency = chance.consistency;
 		c.support = sup.score();
+		c.chance_support = chance.support;
 		c.judged_points = sup.judged();
 		c.score = score;
 		c.other_centre = r.transform.apply(other_centroid);

@@ -182,6 +182,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * same transform: what chance gives in these two maps. */
 		double tolerant_consistency = 0, chance_consistency = 0;
 		double support = 0;  //!< share of wall points near a wall of the other map
+		double chance_support = 0;  //!< the best support under the same far perturbations
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
