@@ -34,11 +34,18 @@ aligner's mirror_check; rows with mirrored=1): each of its candidates is a
 rival and never the best, so a map against its own mirror image, which fits
 itself mirrored exactly, is refused. The pair is merged when value >= threshold.
 
-This script picks chance_weight, evidence, runner_up_weight and floor (the
-most right merges; ties go to the smaller runner-up weight, then the larger
-chance weight and evidence) and sets threshold just above the highest value
-any pair whose best candidate is wrong reaches, plus a safety margin, so that
-no calibration pair would be merged wrong. It prints the ini keys.
+This script picks chance_weight, evidence, runner_up_weight, floor and the
+minimum lead (the most right merges; ties go to the smaller runner-up
+weight, then the larger chance weight, evidence, floor and minimum lead: the
+safer where it costs nothing) and sets threshold just above the highest
+value any pair whose best candidate is wrong reaches, plus a safety margin,
+so that no calibration pair would be merged wrong. It prints the ini keys.
+
+Each CSV given is a sample of its own: the same pair aligned by another
+build or on another machine (other floating-point paths in OpenCV's SIFT
+and warps) has other hypotheses, hence other rivals, and a wrong candidate's
+value moves with its rival ten times over. The fit must hold on every
+sample given; merges are counted over all of them.
 
 The data comes from `multires_bench --calibration-data`: the aligner as it
 runs (the screen on), with exhaustive_search so that every hypothesis is
@@ -82,7 +89,9 @@ def load(paths):
                 if r.get("centre_x") is None or r["calibration"] != "1":
                     continue
                 rows.append({
-                    "pair": (r["site"], r["ref"], r["other"]),
+                    # Each file is its own sample of the pairs: the same pair
+                    # aligned by another build or machine has other hypotheses.
+                    "pair": (r["site"], r["ref"], r["other"], path),
                     "positive": r["positive"] == "1",
                     "right": r["right"] == "1",
                     "near": (r["site"] == "live" and r["right"] != "1" and r["error"] != "nan"
@@ -154,16 +163,21 @@ def main():
                 print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f}: "
                       f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
                       f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
-                rank = (merged_right, -k, w, e, floor, -lead)
+                rank = (merged_right, -k, w, e, floor, lead)
                 if best is None or rank > best[0]:
-                    best = (rank, w, e, k, floor, lead, threshold, merged_right, live_right)
-    _, w, e, k, floor, lead, threshold, merged_right, live_right = best
+                    per_file = collections.Counter(
+                        key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
+                    best = (rank, w, e, k, floor, lead, threshold, merged_right, live_right, per_file)
+    _, w, e, k, floor, lead, threshold, merged_right, live_right, per_file = best
     print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
           f"(margin {MARGIN} above the highest wrong value); live fleet pairs merged right "
           f"{live_right}/{len(live)}")
+    for path in sys.argv[1:]:
+        n = sum(1 for key in positives if key[3] == path)
+        print(f"#   {path}: {per_file[path]}/{n} positive pairs merged right")
 
 
 if __name__ == "__main__":

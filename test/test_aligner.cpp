@@ -340,7 +340,12 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	MMM_REQUIRE_SHARED(orebro, "carmen_corrected/orebro-corrected.log.gz");
 	const ScanSequence &a = scansOf(fr079), &b = scansOf(orebro);
 	const auto ref = renderGrid(a, 0, a.size(), 0.08), other = renderGrid(b, 0, b.size() * 15 / 100, 0.05);
+	const auto d = CScalingGridMapAligner().alignScaled(ref, other);
+	EXPECT_FALSE(d.success) << d.message;
+	// Below the calibrated threshold too: at a threshold its value passes
+	// (its score has no rival), only the gate can refuse it.
 	CScalingGridMapAligner gated, ungated;
+	gated.options.decision_threshold = ungated.options.decision_threshold = 0.3;
 	ungated.options.decision_min_lead = 0;
 	const auto r = gated.alignScaled(ref, other), u = ungated.alignScaled(ref, other);
 	EXPECT_FALSE(r.success) << r.message;

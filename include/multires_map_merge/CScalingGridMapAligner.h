@@ -105,8 +105,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// Calibrated (scripts/calibrate_decision.py, bench/results/calibration.txt)
 		// on E5/HIH pairs, cross-site, CARMEN, mirror and live-fleet data (growing
 		// partial maps of two buildings: without them a fit placed intel's robot
-		// in fr079): no wrong calibration candidate passes.
-		double decision_chance_weight = 0.5;
+		// in fr079), two samples of it made on two machines (their hypotheses,
+		// hence rivals, differ): no wrong calibration candidate passes in either.
+		double decision_chance_weight = 1.0;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 1000;
@@ -115,12 +116,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * buildings whose walls agree about as well anywhere (a small map
 		 * against a large one of another building) prove nothing, however
 		 * few rivals they have. */
-		double decision_min_lead = 0.02;
+		double decision_min_lead = 0.04;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 10.0;
+		double decision_runner_up_weight = 6.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.0;
@@ -130,7 +131,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.535;
+		double decision_threshold = 0.927;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
