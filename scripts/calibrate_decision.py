@@ -44,8 +44,10 @@ so that no calibration pair would be merged wrong. It prints the ini keys.
 Each CSV given is a sample of its own: the same pair aligned by another
 build or on another machine (other floating-point paths in OpenCV's SIFT
 and warps) has other hypotheses, hence other rivals, and a wrong candidate's
-value moves with its rival ten times over. The fit must hold on every
-sample given; merges are counted over all of them.
+value moves with its rival's score times the runner-up weight. The fit must
+hold on every sample given; merges are counted over all of them. The
+defaults need not be the top line: a fit may fail a negative the data lacks
+(README, "How the decision works").
 
 The data comes from `multires_bench --calibration-data`: the aligner as it
 runs (the screen on), with exhaustive_search so that every hypothesis is
