@@ -613,7 +613,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return !expected_scale ||
 			std::abs(std::log(t.scale / *expected_scale)) <= std::log1p(options.metadata_scale_tolerance);
 	};
-	// The screen's bar (refineOne): below it a hypothesis can neither merge
+	// The screen's bar (stopsAtScreen): below it a hypothesis can neither merge
 	// nor, as a rival, lower the best candidate's confidence; raised by
 	// refineAll as better candidates are found.
 	const double least_relevant = mirror_pass && !options.exhaustive_search
@@ -679,19 +679,22 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	auto stopsAtScreen = [&](const Screen& s) {
 		return s.ran && (!s.valid || (!s.may_be_exact && s.score < screen_bar) || convergedOnExact(s));
 	};
-	auto refineOne = [&](const Hypothesis& h, const Screen& s) {
+	// What a hypothesis that stops at its screen leaves: its screen's
+	// candidate (none without a valid screen).
+	auto screenedOnly = [&](const Hypothesis& h, const Screen& s) {
 		Refined out;
 		out.icp_s = s.icp_s, out.verify_s = s.verify_s;
-		if (s.ran && !s.valid) return out;
-		if (stopsAtScreen(s))
-		{
-			out.cand = candidate(h, s.quick, s.rmse_coarse, std::numeric_limits<double>::quiet_NaN(), s.sup, s.chance, s.score);
-			out.cand.screened = true;
-			out.cand.converged_on_exact = convergedOnExact(s);
-			out.r = s.quick;
-			out.valid = true;
-			return out;
-		}
+		if (!s.valid) return out;
+		out.cand = candidate(h, s.quick, s.rmse_coarse, std::numeric_limits<double>::quiet_NaN(), s.sup, s.chance, s.score);
+		out.cand.screened = true;
+		out.cand.converged_on_exact = convergedOnExact(s);
+		out.r = s.quick;
+		out.valid = true;
+		return out;
+	};
+	auto refineInFull = [&](const Hypothesis& h, const Screen& s) {
+		Refined out;
+		out.icp_s = s.icp_s, out.verify_s = s.verify_s;
 		// Independent maps: refined on every point from the sample's result
 		// (fewer iterations; the same optimum to within a cell). Where the
 		// maps may coincide cell for cell, from the hypothesis, as without the
@@ -839,6 +842,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		for (size_t first = 0; first < n && !stop;)
 		{
 			if (!options.exhaustive_search) screen_bar = screenBar();
+			std::vector<Refined> done;
 			std::vector<size_t> in_full;  // hypotheses of this round refined on every point
 			size_t end = first;
 			while (end < n && in_full.size() < threads)
@@ -851,18 +855,16 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					});
 					screened_up_to = upto;
 				}
-				if (!stopsAtScreen(screens[end])) in_full.push_back(end);
+				if (stopsAtScreen(screens[end]))
+					done.push_back(screenedOnly(list[end], screens[end]));
+				else
+					done.emplace_back(), in_full.push_back(end);
 				++end;
 			}
-			std::vector<Refined> done(end - first);
-			if (!in_full.empty())
-				cv::parallel_for_(cv::Range(0, int(in_full.size())), [&](const cv::Range& range) {
-					for (int k = range.start; k < range.end; ++k)
-						done[in_full[k] - first] = refineOne(list[in_full[k]], screens[in_full[k]]);
-				});
-			for (size_t j = first; j < end; ++j)
-				if (std::find(in_full.begin(), in_full.end(), j) == in_full.end())
-					done[j - first] = refineOne(list[j], screens[j]);  // stops at its screen
+			cv::parallel_for_(cv::Range(0, int(in_full.size())), [&](const cv::Range& range) {
+				for (int k = range.start; k < range.end; ++k)
+					done[in_full[k] - first] = refineInFull(list[in_full[k]], screens[in_full[k]]);
+			});
 			for (size_t j = first; j < end; ++j)
 			{
 				const Hypothesis& h = list[j];
