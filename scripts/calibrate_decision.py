@@ -32,7 +32,12 @@ alignment of one building stands out, a chance fit between two buildings has
 rivals nearly as good. The other map's mirror image is aligned too (the
 aligner's mirror_check; rows with mirrored=1): each of its candidates is a
 rival and never the best, so a map against its own mirror image, which fits
-itself mirrored exactly, is refused. The pair is merged when value >= threshold.
+itself mirrored exactly, is refused. The pair is merged when value >= threshold, and only if its best candidate's
+T leads C by the minimum lead and its wall alignment A (the share of wall
+points near a wall of the other map whose wall runs the same way, within
+20 degrees) reaches the minimum wall alignment: independent maps of one
+building differ in where their walls are by a few cells, not in which way
+they run, while a wrong alignment lays walls across walls.
 
 This script picks chance_weight, evidence, runner_up_weight, floor and the
 minimum lead (the most right merges; ties go to the smaller runner-up
@@ -72,6 +77,8 @@ FLOORS = [-0.5, 0.0, 0.25]
 # decision_min_lead: the best candidate's tolerant consistency must exceed
 # chance by this to merge on its walls.
 LEADS = [0.0, 0.02, 0.04]
+# decision_min_wall_alignment (0: no gate).
+ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.78, 0.8]
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
@@ -102,6 +109,8 @@ def load(paths):
                     "mirrored": r.get("mirrored") == "1",
                     "T": float(r["tolerant_consistency"]),
                     "C": float(r["chance_consistency"]),
+                    # Absent from data written before it was measured: no gate there.
+                    "A": float(r.get("wall_alignment") or "nan"),
                     "n": max(1, int(r["judged"])),
                     "scale": float(r["scale"]),
                     "yaw": math.radians(float(r["yaw_deg"])),
@@ -148,13 +157,14 @@ def main():
                 judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
                 if judged:
                     tops[key] = max(judged, key=lambda r: scores[id(r)])
-            for k, floor, lead in itertools.product(RUNNER_UP, FLOORS, LEADS):
+            for k, floor, lead, align in itertools.product(RUNNER_UP, FLOORS, LEADS, ALIGNMENTS):
                 def value(top):
                     s = scores[id(top)]
                     rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
                     return s + k * (s - rival)
-                # A top not leading chance by `lead` cannot merge: below any threshold.
-                values = {key: value(top) if top["T"] - top["C"] >= lead else -math.inf
+                # A top not leading chance by `lead`, or whose near walls run
+                # alike less than `align`, cannot merge: below any threshold.
+                values = {key: value(top) if top["T"] - top["C"] >= lead and not top["A"] < align else -math.inf
                           for key, top in tops.items()}
                 wrong = [v for key, v in values.items() if not tops[key]["right"] and not tops[key]["near"]]
                 threshold = max(wrong) + MARGIN
@@ -162,16 +172,18 @@ def main():
                                    if key in tops and tops[key]["right"] and values[key] >= threshold)
                 live_right = sum(1 for key in live
                                  if key in tops and tops[key]["right"] and values[key] >= threshold)
-                print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f}: "
+                print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f} "
+                      f"alignment {align:4.2f}: "
                       f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
                       f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
-                rank = (merged_right, -k, w, e, floor, lead)
+                rank = (merged_right, -k, w, e, floor, lead, align)
                 if best is None or rank > best[0]:
                     per_file = collections.Counter(
                         key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
-                    best = (rank, w, e, k, floor, lead, threshold, merged_right, live_right, per_file)
-    _, w, e, k, floor, lead, threshold, merged_right, live_right, per_file = best
+                    best = (rank, w, e, k, floor, lead, align, threshold, merged_right, live_right, per_file)
+    _, w, e, k, floor, lead, align, threshold, merged_right, live_right, per_file = best
     print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
+          f"decision_min_wall_alignment = {align}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "

@@ -61,6 +61,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(decision_chance_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_lead, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_min_wall_alignment, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_floor, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(distinct_shift, double, c, s);
@@ -107,6 +108,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("decision_chance_weight", decision_chance_weight, 0, 10);
 	in("decision_evidence", decision_evidence, 0, 1e6);
 	in("decision_min_lead", decision_min_lead, -1, 1);
+	in("decision_min_wall_alignment", decision_min_wall_alignment, 0, 1);
 	in("decision_runner_up_weight", decision_runner_up_weight, 0, 100);
 	in("decision_runner_up_floor", decision_runner_up_floor, -10, 10);
 	in("distinct_shift", distinct_shift, 1, 1e4);
@@ -149,6 +151,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = T + w (T - chance T) - sqrt(evidence / judged)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_lead, "Merged on its walls only if they agree more than chance by this");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_wall_alignment, "Merged on its walls only if this share of near walls run alike");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_weight, "Decision value = best score + w (it - best distinct rival's score)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_floor, "A rival scoring below this counts as this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(distinct_shift, "Candidates this far apart are rivals [coarse cells]");
@@ -185,6 +188,11 @@ bool CScalingGridMapAligner::areRivals(const TCandidate& a, const TCandidate& b)
 bool CScalingGridMapAligner::TConfigParams::leadsChance(double tolerant_consistency, double chance_consistency) const
 {
 	return tolerant_consistency - chance_consistency >= decision_min_lead;
+}
+
+bool CScalingGridMapAligner::TConfigParams::wallsRunAlike(double wall_alignment) const
+{
+	return wall_alignment >= decision_min_wall_alignment;
 }
 
 double CScalingGridMapAligner::TConfigParams::lowestMergeableScore() const
@@ -603,6 +611,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.chance_consistency = chance.consistency;
 		c.support = sup.score();
 		c.chance_support = chance.support;
+		c.deep_consistency = sup.deepConsistency();
+		c.wall_alignment = sup.alignment();
 		c.judged_points = sup.judged();
 		c.score = score;
 		c.other_centre = r.transform.apply(other_centroid);
@@ -749,13 +759,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// confidence (a rival scores at most as much, so the decision value is at
 	// least the score; one scoring more would itself be merged). Searching on
 	// is then only time: independent maps never get there (calibration data).
-	auto leadsChance = [&](const TCandidate& c) {
-		return options.leadsChance(c.tolerant_consistency, c.chance_consistency);
+	auto mayMergeOnWalls = [&](const TCandidate& c) {
+		return options.leadsChance(c.tolerant_consistency, c.chance_consistency) &&
+			options.wallsRunAlike(c.wall_alignment);
 	};
 	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
 		return c.exact_confidence >= exact_needed ||
 			(!c.screened && c.judged_points >= kMinJudgedPoints && c.score >= options.decision_runner_up_floor &&
-			 leadsChance(c) &&
+			 mayMergeOnWalls(c) &&
 			 confidenceOfValue(c.score) >= std::max(0.5, options.min_confidence));
 	};
 	// Two ways to be sure: the maps coincide cell for cell (a candidate's
@@ -782,14 +793,18 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 					c.runner_up_score = std::max(c.runner_up_score, o.score);
 			c.decision_value =
 				c.score + options.decision_runner_up_weight * (c.score - c.runner_up_score);
-			if (leadsChance(c)) c.confidence = std::max(c.confidence, confidenceOfValue(c.decision_value));
+			if (mayMergeOnWalls(c)) c.confidence = std::max(c.confidence, confidenceOfValue(c.decision_value));
 		}
+		// At equal confidence (none at all, typically) the candidate decided
+		// on is reported: a refusal then says why that one was not enough.
 		std::optional<size_t> chosen;
+		auto before = [&](size_t i, size_t j) {
+			if (cands[i].confidence != cands[j].confidence) return cands[i].confidence > cands[j].confidence;
+			if ((i == best) != (j == best)) return i == best;
+			return judged[i].r.objective < judged[j].r.objective;
+		};
 		for (size_t i = 0; i < cands.size(); ++i)
-			if (!cands[i].mirrored && (!chosen || cands[i].confidence > cands[*chosen].confidence ||
-				 (cands[i].confidence == cands[*chosen].confidence &&
-				  judged[i].r.objective < judged[*chosen].r.objective)))
-				chosen = i;
+			if (!cands[i].mirrored && (!chosen || before(i, *chosen))) chosen = i;
 		if (!chosen) return;
 		have = true;
 		const TCandidate& cand = cands[*chosen];
@@ -802,6 +817,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.trimmed_rmse_coarse_cells = cand.rmse_coarse_cells;
 		info.consistency = cand.tolerant_consistency;
 		info.chance_consistency = cand.chance_consistency;
+		info.wall_alignment = cand.wall_alignment;
 		info.score = cand.score;
 		info.runner_up_score = cand.runner_up_score;
 		info.decision_value = cand.decision_value;
@@ -993,6 +1009,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (std::isfinite(info.decision_value) && !options.leadsChance(info.consistency, info.chance_consistency))
 			why << ", walls agreeing no more than chance (less than decision_min_lead = " << options.decision_min_lead
 				<< " above it)";
+		if (std::isfinite(info.decision_value) && !options.wallsRunAlike(info.wall_alignment))
+			why << ", walls near the other map's running alike in only " << info.wall_alignment
+				<< " of the cases (decision_min_wall_alignment = " << options.decision_min_wall_alignment << ")";
 		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
 		if (info.mirror_score > info.score)
 			why << "; the other map fits better mirrored (score " << info.mirror_score

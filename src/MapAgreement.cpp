@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace multires_map_merge
 {
@@ -18,6 +19,67 @@ cv::Mat clearlyFree(const cv::Mat& classes, int radius)
 	cv::erode(
 		classes == kFree, out,
 		cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * radius + 1, 2 * radius + 1)));
+	return out;
+}
+
+// Wall normals from the structure tensor of the occupied cells, smoothed over
+// a couple of cells (a wall drawn two cells thick has one direction), taken
+// at each occupied cell only and carried to every cell from its nearest
+// occupied cell. Gradients in 16 bits and labels for one pass: a 4000² map
+// must not pay several float images for it.
+cv::Mat nearestWallNormal(const cv::Mat& classes)
+{
+	const cv::Mat occupied = classes == kOccupied;
+	cv::Mat gx, gy;
+	cv::Sobel(occupied / 255, gx, CV_16S, 1, 0, 3);
+	cv::Sobel(occupied / 255, gy, CV_16S, 0, 1, 3);
+	constexpr int kRadius = 6;
+	constexpr double kSigma = 2.0;
+	float weight[2 * kRadius + 1][2 * kRadius + 1];
+	for (int dy = -kRadius; dy <= kRadius; ++dy)
+		for (int dx = -kRadius; dx <= kRadius; ++dx)
+			weight[dy + kRadius][dx + kRadius] = float(std::exp(-(dx * dx + dy * dy) / (2 * kSigma * kSigma)));
+	// Labels number the occupied cells in raster order, from 1.
+	std::vector<uint8_t> normal_of_label(1, kNoDirection);
+	for (int y = 0; y < classes.rows; ++y)
+		for (int x = 0; x < classes.cols; ++x)
+		{
+			if (!occupied.at<uint8_t>(y, x)) continue;
+			float a = 0, b = 0, c = 0;
+			for (int v = std::max(0, y - kRadius); v <= std::min(classes.rows - 1, y + kRadius); ++v)
+			{
+				const int16_t *rx = gx.ptr<int16_t>(v), *ry = gy.ptr<int16_t>(v);
+				const float* wr = weight[v - y + kRadius];
+				for (int u = std::max(0, x - kRadius); u <= std::min(classes.cols - 1, x + kRadius); ++u)
+				{
+					if (rx[u] == 0 && ry[u] == 0) continue;
+					const float w = wr[u - x + kRadius], fx = rx[u], fy = ry[u];
+					a += w * fx * fx, b += w * fy * fy, c += w * fx * fy;
+				}
+			}
+			const float trace = a + b, aniso = std::sqrt((a - b) * (a - b) + 4 * c * c);
+			uint8_t dir = kNoDirection;
+			if (trace > 0 && aniso > 0.5f * trace)  // a line, not a corner or a speck
+			{
+				double deg = 0.5 * std::atan2(2.0 * c, double(a - b)) * 180.0 / M_PI;
+				if (deg < 0) deg += 180;
+				dir = static_cast<uint8_t>(std::min(179.0, std::floor(deg)));
+			}
+			normal_of_label.push_back(dir);
+		}
+	cv::Mat out(classes.size(), CV_8U, cv::Scalar(kNoDirection));
+	if (normal_of_label.size() == 1) return out;
+	gx.release(), gy.release();
+	cv::Mat labels, dist;
+	cv::distanceTransform(~occupied, dist, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
+	dist.release();
+	for (int y = 0; y < classes.rows; ++y)
+	{
+		const int* l = labels.ptr<int>(y);
+		uint8_t* o = out.ptr<uint8_t>(y);
+		for (int x = 0; x < classes.cols; ++x)
+			if (l[x] > 0 && size_t(l[x]) < normal_of_label.size()) o[x] = normal_of_label[size_t(l[x])];
+	}
 	return out;
 }
 }  // namespace
@@ -62,6 +124,7 @@ OccupancyField occupancyField(const cv::Mat& classes)
 	cv::distanceTransform(classes != kOccupied, f.dist_to_occupied, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 	cv::distanceTransform(classes == kFree, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 	f.known = classes != kUnknown;
+	f.nearest_wall_normal_deg = nearestWallNormal(classes);
 	return f;
 }
 
@@ -74,11 +137,14 @@ cv::Mat knownWithin(const cv::Mat& known, double cells)
 }
 
 Support tolerantSupport(
-	const PointList& points, const Similarity2D& t, const OccupancyField& target, double tolerance)
+	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target,
+	double tolerance)
 {
 	Support s;
 	const int w = target.known.cols, h = target.known.rows;
 	const Eigen::Matrix2d a = t.linear();
+	const double turn_deg = t.yaw * 180.0 / M_PI;
+	const bool directions = !source.nearest_wall_normal_deg.empty() && !target.nearest_wall_normal_deg.empty();
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
@@ -88,11 +154,25 @@ Support tolerantSupport(
 		// cell (walls border unknown space); elsewhere only seen space judges.
 		const float d = target.dist_to_occupied.at<float>(y, x);
 		if (d <= tolerance)
+		{
 			++s.judged, ++s.supported;
+			if (!directions) continue;
+			const int px = static_cast<int>(std::lround(p.x())), py = static_cast<int>(std::lround(p.y()));
+			if (px < 0 || py < 0 || px >= source.nearest_wall_normal_deg.cols || py >= source.nearest_wall_normal_deg.rows)
+				continue;
+			const uint8_t ds = source.nearest_wall_normal_deg.at<uint8_t>(py, px);
+			const uint8_t dt = target.nearest_wall_normal_deg.at<uint8_t>(y, x);
+			if (ds == kNoDirection || dt == kNoDirection) continue;
+			++s.oriented;
+			const double diff = std::abs(std::remainder(double(ds) + turn_deg - double(dt), 180.0));
+			s.aligned += diff <= 20.0;
+		}
 		else if (target.known.at<uint8_t>(y, x))
 		{
 			++s.judged;
-			s.conflicts += target.dist_to_not_free.at<float>(y, x) > tolerance;
+			const float free_depth = target.dist_to_not_free.at<float>(y, x);
+			s.conflicts += free_depth > tolerance;
+			s.deep_conflicts += free_depth > 3 * tolerance;
 		}
 	}
 	return s;
@@ -119,9 +199,10 @@ TwoWaySupport twoWaySupport(
 	// One coarse cell, in each map's own cells.
 	const double coarse_in_ref = std::max(1.0, other_to_ref.scale);
 	const double coarse_in_other = std::max(1.0, 1.0 / other_to_ref.scale);
-	s.other_in_ref = tolerantSupport(thinned(other_points, most), other_to_ref, ref_field, tol_coarse * coarse_in_ref);
-	s.ref_in_other =
-		tolerantSupport(thinned(ref_points, most), other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other);
+	s.other_in_ref =
+		tolerantSupport(thinned(other_points, most), other_field, other_to_ref, ref_field, tol_coarse * coarse_in_ref);
+	s.ref_in_other = tolerantSupport(
+		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other);
 	return s;
 }
 

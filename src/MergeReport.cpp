@@ -33,6 +33,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"inliers", r.ransac_inliers},
 		{"consistency", num(r.consistency)},
 		{"chance_consistency", num(r.chance_consistency)},
+		{"wall_alignment", num(r.wall_alignment)},
 		{"score", num(r.score)},
 		{"runner_up_score", num(r.runner_up_score)},
 		{"decision_value", num(r.decision_value)},

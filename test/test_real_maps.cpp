@@ -111,7 +111,9 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		EXPECT_GT(rival, o.decision_runner_up_floor) << rivals << " rivals";
 		EXPECT_DOUBLE_EQ(best->runner_up_score, rival);
 		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision_runner_up_weight * (best->score - rival));
-		EXPECT_EQ(res.success, best->decision_value >= o.decision_threshold);
+		const bool walls_may_merge = o.leadsChance(best->tolerant_consistency, best->chance_consistency) &&
+			o.wallsRunAlike(best->wall_alignment);
+		EXPECT_EQ(res.success, walls_may_merge && best->decision_value >= o.decision_threshold);
 		if (res.success)
 		{
 			EXPECT_DOUBLE_EQ(res.decision_value, best->decision_value);
@@ -119,6 +121,8 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		else
 		{
 			EXPECT_NE(res.message.find("best rival"), std::string::npos) << res.message;
+			if (!o.wallsRunAlike(best->wall_alignment))
+				EXPECT_NE(res.message.find("running alike"), std::string::npos) << res.message;
 		}
 	}
 }
@@ -149,13 +153,13 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 	EXPECT_FALSE(res.success) << "confidence " << res.confidence;
 
 	// Against its own mirror image the map's symmetries fit well enough to
-	// merge on the walls alone (its decision value, about 0.86, is above the
-	// default threshold too; the test sets 0.7 to not hang on that);
-	// the mirror check sees that the map fits itself better mirrored, refuses,
-	// and says why.
+	// merge on the walls' consistency alone (without the wall-alignment
+	// gate, which by itself refuses this pair only just: its near walls run
+	// alike about as often as the gate's bar); the mirror check sees that
+	// the map fits itself better mirrored, refuses, and says why.
 	const GridInFrame original = loadGridMap(halmstad()->yaml("E5_01", dir()));
 	CScalingGridMapAligner unchecked, checked;
-	unchecked.options.decision_threshold = checked.options.decision_threshold = 0.7;
+	unchecked.options.decision_min_wall_alignment = checked.options.decision_min_wall_alignment = 0;
 	unchecked.options.mirror_check = false;
 	ASSERT_TRUE(checked.options.mirror_check);
 	const auto without = unchecked.alignScaled(original, mirrored);

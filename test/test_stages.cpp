@@ -196,6 +196,44 @@ TEST(MapAgreement, TolerantConsistencyIsAPeakAboveChance)
 	EXPECT_LT(far.consistency(), at_truth.consistency() - 0.15);
 }
 
+TEST(MapAgreement, WallNormalsAreCarriedFromTheNearestWall)
+{
+	// A horizontal wall (normal along y) and a vertical one (normal along x)
+	// meeting it in a T: every cell gets the normal of the wall nearest to
+	// it; the junction has none.
+	cv::Mat classes(60, 60, CV_8U, cv::Scalar(kFree));
+	classes.row(10).setTo(kOccupied);
+	classes(cv::Rect(45, 10, 1, 50)).setTo(kOccupied);
+	const cv::Mat normal = occupancyField(classes).nearest_wall_normal_deg;
+	EXPECT_NEAR(normal.at<uint8_t>(14, 20), 90, 1);
+	EXPECT_NEAR(normal.at<uint8_t>(10, 30), 90, 1);
+	const int vertical = normal.at<uint8_t>(40, 50);
+	EXPECT_TRUE(vertical <= 1 || vertical >= 179) << vertical;
+	EXPECT_EQ(normal.at<uint8_t>(10, 45), kNoDirection) << "a T junction runs no one way";
+}
+
+TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
+{
+	// At the truth (and with walls bent by two cells) the walls lying near
+	// the other map's walls run the same way; turned by 45° about the map's
+	// centre, the walls that still lie near walls cross them.
+	const auto pair = malaga5and10();
+	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
+	const PointList ea = edgePoints(a), eb = edgePoints(b);
+	const OccupancyField fa = occupancyField(a), fb = occupancyField(b);
+	const Similarity2D truth = pair.otherCellsToRefCells();
+	const TwoWaySupport at_truth = twoWaySupport(ea, fa, eb, fb, truth, 3.0);
+	EXPECT_GT(at_truth.alignment(), 0.9);
+	EXPECT_GT(at_truth.other_in_ref.oriented, 300u);
+	const TwoWaySupport bent = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {4, 0}).compose(truth), 3.0);
+	EXPECT_GT(bent.alignment(), 0.85);
+	const Eigen::Vector2d centre(a.cols / 2.0, a.rows / 2.0);
+	Similarity2D turn(1, M_PI / 4, {0, 0});
+	turn.t = centre - turn.apply(centre);
+	const TwoWaySupport turned = twoWaySupport(ea, fa, eb, fb, turn.compose(truth), 3.0);
+	EXPECT_LT(turned.alignment(), 0.5);
+}
+
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 {
 	// The same real map at 5 and 8 cm (rendered from the scans), the coarse

@@ -107,21 +107,27 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// partial maps of two buildings: without them a fit placed intel's robot
 		// in fr079), two samples of it made on two machines (their hypotheses,
 		// hence rivals, differ): no wrong calibration candidate passes in either.
-		double decision_chance_weight = 1.0;
+		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 1000;
+		double decision_evidence = 400;
 		/** The best candidate merges on its walls only if they agree more
 		 * than chance by at least this (tolerant consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
 		 * against a large one of another building) prove nothing, however
 		 * few rivals they have. */
 		double decision_min_lead = 0.04;
+		/** The best candidate merges on its walls only if at least this
+		 * share of the wall points lying near a wall of the other map run
+		 * the same way as that wall (within 20°): a wrong alignment puts
+		 * walls across walls as often as along them, and a map's walls lying
+		 * near the other's by chance mostly cross them. Calibrated. */
+		double decision_min_wall_alignment = 0.75;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 6.0;
+		double decision_runner_up_weight = 1.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.0;
@@ -131,7 +137,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.927;
+		double decision_threshold = 0.397;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -164,6 +170,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Walls agreeing this well (tolerant consistency) against chance
 		 * may merge on them: they lead chance by decision_min_lead. */
 		bool leadsChance(double tolerant_consistency, double chance_consistency) const;
+		/** Walls near each other run alike in at least
+		 * decision_min_wall_alignment of the cases. */
+		bool wallsRunAlike(double wall_alignment) const;
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
@@ -184,6 +193,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double tolerant_consistency = 0, chance_consistency = 0;
 		double support = 0;  //!< share of wall points near a wall of the other map
 		double chance_support = 0;  //!< the best support under the same far perturbations
+		/** The tolerant consistency counting only conflicts deep in free
+		 * space, and the share of supported wall points whose wall directions
+		 * agree (MapAgreement.h, TwoWaySupport). */
+		double deep_consistency = 0, wall_alignment = 0;
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
@@ -236,6 +249,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Tolerant consistency of the chosen candidate (TCandidate), and
 		 * the best of it under far perturbations (chance). */
 		double consistency = 0, chance_consistency = 0;
+		double wall_alignment = 0;  //!< TCandidate::wall_alignment of the chosen candidate
 		/** The chosen candidate's score, and where it is the pair's best-
 		 * scoring one, its best distinct rival's score and the decision value
 		 * (TCandidate; NaN otherwise). */

@@ -44,7 +44,12 @@ struct OccupancyField
 	cv::Mat dist_to_occupied;  //!< CV_32F, cells to the nearest occupied cell
 	cv::Mat dist_to_not_free;  //!< CV_32F, cells to the nearest occupied or unknown cell
 	cv::Mat known;  //!< CV_8U, non-zero where the map has seen the space
+	/** CV_8U: the direction (degrees, 0–179) of the wall normal at the
+	 * nearest occupied cell; kNoDirection where that wall has none (a corner,
+	 * a speck). */
+	cv::Mat nearest_wall_normal_deg;
 };
+constexpr uint8_t kNoDirection = 255;
 OccupancyField occupancyField(const cv::Mat& classes);
 
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
@@ -58,6 +63,12 @@ struct Support
 	/** Of those, on free space farther than the tolerance from any wall or
 	 * unknown cell: a wall where the target clearly sees none. */
 	size_t conflicts = 0;
+	/** Of the conflicts, those farther than three tolerances from any wall
+	 * or unknown cell: not a bent wall. */
+	size_t deep_conflicts = 0;
+	/** Of the supported points, those where both walls have a direction, and
+	 * of these the ones whose directions agree within 20°. */
+	size_t oriented = 0, aligned = 0;
 	double ratio() const { return judged ? double(supported) / double(judged) : 0.0; }
 };
 
@@ -65,8 +76,8 @@ struct Support
  * into the target map: how many land on its known space, and how many of
  * those within `tolerance` target cells of an occupied cell. */
 Support tolerantSupport(
-	const PointList& points, const Similarity2D& source_to_target, const OccupancyField& target,
-	double tolerance);
+	const PointList& points, const OccupancyField& source, const Similarity2D& source_to_target,
+	const OccupancyField& target, double tolerance);
 
 /** Wall points judged per map at most (evenly thinned): the ratios, not the
  * counts, matter. A screen judges fewer. */
@@ -85,6 +96,19 @@ struct TwoWaySupport
 	{
 		const size_t j = other_in_ref.judged + ref_in_other.judged;
 		return j ? 1.0 - double(other_in_ref.conflicts + ref_in_other.conflicts) / double(j) : 0.0;
+	}
+	/** The same with deep conflicts only. */
+	double deepConsistency() const
+	{
+		const size_t j = other_in_ref.judged + ref_in_other.judged;
+		return j ? 1.0 - double(other_in_ref.deep_conflicts + ref_in_other.deep_conflicts) / double(j) : 0.0;
+	}
+	/** Share of supported points with directions on both walls whose
+	 * directions agree, over both directions. */
+	double alignment() const
+	{
+		const size_t o = other_in_ref.oriented + ref_in_other.oriented;
+		return o ? double(other_in_ref.aligned + ref_in_other.aligned) / double(o) : 0.0;
 	}
 };
 
