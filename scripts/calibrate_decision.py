@@ -44,7 +44,9 @@ minimum lead (the most right merges; ties go to the smaller runner-up
 weight, then the larger chance weight, evidence, floor and minimum lead: the
 safer where it costs nothing) and sets threshold just above the highest
 value any pair whose best candidate is wrong reaches, plus a safety margin,
-so that no calibration pair would be merged wrong. It prints the ini keys.
+so that no calibration pair would be merged wrong, and treats a wrong pair
+just below a gate (ALIGNMENT_MARGIN, LEAD_MARGIN) as through it. It prints
+the ini keys.
 
 Each CSV given is a sample of its own: the same pair aligned by another
 build or on another machine (other floating-point paths in OpenCV's SIFT
@@ -70,6 +72,13 @@ import math
 import sys
 
 MARGIN = 0.02  # safety margin above the highest wrong value
+# The gates need margins too: a wrong pair's wall alignment or lead over
+# chance moves by a few hundredths with the machine and build (other
+# hypotheses, other refinements); one that sits just below a gate would merge
+# where it crosses it. So a wrong pair within these margins below a gate sets
+# the threshold as if it had passed.
+ALIGNMENT_MARGIN = 0.02
+LEAD_MARGIN = 0.01
 WEIGHTS = [0.5, 1.0, 1.5]
 EVIDENCE = [200, 400, 1000]
 RUNNER_UP = [0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0]
@@ -78,7 +87,7 @@ FLOORS = [-0.5, 0.0, 0.25]
 # chance by this to merge on its walls.
 LEADS = [0.0, 0.02, 0.04]
 # decision_min_wall_alignment (0: no gate).
-ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.78, 0.8]
+ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.77, 0.78, 0.8]
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
@@ -164,9 +173,12 @@ def main():
                     return s + k * (s - rival)
                 # A top not leading chance by `lead`, or whose near walls run
                 # alike less than `align`, cannot merge: below any threshold.
-                values = {key: value(top) if top["T"] - top["C"] >= lead and not top["A"] < align else -math.inf
-                          for key, top in tops.items()}
-                wrong = [v for key, v in values.items() if not tops[key]["right"] and not tops[key]["near"]]
+                # Wrong tops within the gates' margins count as through them.
+                def through(top, lead_margin, align_margin):
+                    return top["T"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
+                values = {key: value(top) if through(top, 0, 0) else -math.inf for key, top in tops.items()}
+                wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN) else -math.inf
+                         for key, top in tops.items() if not top["right"] and not top["near"]]
                 threshold = max(wrong) + MARGIN
                 merged_right = sum(1 for key in positives
                                    if key in tops and tops[key]["right"] and values[key] >= threshold)

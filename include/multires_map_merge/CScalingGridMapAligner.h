@@ -122,7 +122,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * the same way as that wall (within 20°): a wrong alignment puts
 		 * walls across walls as often as along them, and a map's walls lying
 		 * near the other's by chance mostly cross them. Calibrated. */
-		double decision_min_wall_alignment = 0.75;
+		double decision_min_wall_alignment = 0.77;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
