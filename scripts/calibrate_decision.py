@@ -71,7 +71,11 @@ import itertools
 import math
 import sys
 
-MARGIN = 0.02  # safety margin above the highest wrong value
+# Safety margin above the highest wrong value, in score units: the decision
+# value moves (1 + runner-up weight) times as much as a score, so the margin
+# does too (a quarter of the confidence scale, 0.2 (1 + weight) per unit).
+# Why this large: README, "How the decision works".
+MARGIN = 0.05
 # The gates need margins too: a wrong pair's wall alignment or lead over
 # chance moves by a few hundredths with the machine and build (other
 # hypotheses, other refinements); one that sits just below a gate would merge
@@ -179,7 +183,7 @@ def main():
                 values = {key: value(top) if through(top, 0, 0) else -math.inf for key, top in tops.items()}
                 wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN) else -math.inf
                          for key, top in tops.items() if not top["right"] and not top["near"]]
-                threshold = max(wrong) + MARGIN
+                threshold = max(wrong) + MARGIN * (1 + k)
                 merged_right = sum(1 for key in positives
                                    if key in tops and tops[key]["right"] and values[key] >= threshold)
                 live_right = sum(1 for key in live
@@ -199,7 +203,7 @@ def main():
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
-          f"(margin {MARGIN} above the highest wrong value); live fleet pairs merged right "
+          f"(margin {MARGIN} x (1 + runner-up weight) above the highest wrong value); live fleet pairs merged right "
           f"{live_right}/{len(live)}")
     for path in sys.argv[1:]:
         n = sum(1 for key in positives if key[3] == path)

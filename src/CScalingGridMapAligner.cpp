@@ -611,8 +611,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.chance_consistency = chance.consistency;
 		c.support = sup.score();
 		c.chance_support = chance.support;
-		c.deep_consistency = sup.deepConsistency();
-		c.wall_alignment = sup.alignment();
+		c.wall_alignment = sup.wallAlignment();
 		c.judged_points = sup.judged();
 		c.score = score;
 		c.other_centre = r.transform.apply(other_centroid);

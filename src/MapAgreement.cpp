@@ -23,13 +23,12 @@ cv::Mat clearlyFree(const cv::Mat& classes, int radius)
 }
 
 // Wall normals from the structure tensor of the occupied cells, smoothed over
-// a couple of cells (a wall drawn two cells thick has one direction), taken
-// at each occupied cell only and carried to every cell from its nearest
-// occupied cell. Gradients in 16 bits and labels for one pass: a 4000² map
-// must not pay several float images for it.
-cv::Mat nearestWallNormal(const cv::Mat& classes)
+// a couple of cells (a wall drawn two cells thick has one direction), at each
+// occupied cell (kNoDirection elsewhere). Gradients in 16 bits and the tensor
+// summed at occupied cells only: a 4000² map must not pay several float
+// images for it.
+cv::Mat wallNormals(const cv::Mat& occupied)
 {
-	const cv::Mat occupied = classes == kOccupied;
 	cv::Mat gx, gy;
 	cv::Sobel(occupied / 255, gx, CV_16S, 1, 0, 3);
 	cv::Sobel(occupied / 255, gy, CV_16S, 0, 1, 3);
@@ -39,18 +38,17 @@ cv::Mat nearestWallNormal(const cv::Mat& classes)
 	for (int dy = -kRadius; dy <= kRadius; ++dy)
 		for (int dx = -kRadius; dx <= kRadius; ++dx)
 			weight[dy + kRadius][dx + kRadius] = float(std::exp(-(dx * dx + dy * dy) / (2 * kSigma * kSigma)));
-	// Labels number the occupied cells in raster order, from 1.
-	std::vector<uint8_t> normal_of_label(1, kNoDirection);
-	for (int y = 0; y < classes.rows; ++y)
-		for (int x = 0; x < classes.cols; ++x)
+	cv::Mat out(occupied.size(), CV_8U, cv::Scalar(kNoDirection));
+	for (int y = 0; y < occupied.rows; ++y)
+		for (int x = 0; x < occupied.cols; ++x)
 		{
 			if (!occupied.at<uint8_t>(y, x)) continue;
 			float a = 0, b = 0, c = 0;
-			for (int v = std::max(0, y - kRadius); v <= std::min(classes.rows - 1, y + kRadius); ++v)
+			for (int v = std::max(0, y - kRadius); v <= std::min(occupied.rows - 1, y + kRadius); ++v)
 			{
 				const int16_t *rx = gx.ptr<int16_t>(v), *ry = gy.ptr<int16_t>(v);
 				const float* wr = weight[v - y + kRadius];
-				for (int u = std::max(0, x - kRadius); u <= std::min(classes.cols - 1, x + kRadius); ++u)
+				for (int u = std::max(0, x - kRadius); u <= std::min(occupied.cols - 1, x + kRadius); ++u)
 				{
 					if (rx[u] == 0 && ry[u] == 0) continue;
 					const float w = wr[u - x + kRadius], fx = rx[u], fy = ry[u];
@@ -58,27 +56,37 @@ cv::Mat nearestWallNormal(const cv::Mat& classes)
 				}
 			}
 			const float trace = a + b, aniso = std::sqrt((a - b) * (a - b) + 4 * c * c);
-			uint8_t dir = kNoDirection;
 			if (trace > 0 && aniso > 0.5f * trace)  // a line, not a corner or a speck
 			{
 				double deg = 0.5 * std::atan2(2.0 * c, double(a - b)) * 180.0 / M_PI;
 				if (deg < 0) deg += 180;
-				dir = static_cast<uint8_t>(std::min(179.0, std::floor(deg)));
+				out.at<uint8_t>(y, x) = static_cast<uint8_t>(std::min(179.0, std::floor(deg)));
 			}
-			normal_of_label.push_back(dir);
 		}
-	cv::Mat out(classes.size(), CV_8U, cv::Scalar(kNoDirection));
-	if (normal_of_label.size() == 1) return out;
-	gx.release(), gy.release();
-	cv::Mat labels, dist;
-	cv::distanceTransform(~occupied, dist, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
-	dist.release();
-	for (int y = 0; y < classes.rows; ++y)
+	return out;
+}
+
+// Per direction bin, the distance (cells, saturated at 255) to the nearest
+// wall whose normal lies within kBinHalfWidthDeg of the bin's centre.
+constexpr double kBinHalfWidthDeg = 20.0;
+std::vector<cv::Mat> distanceToWallByDirection(const cv::Mat& normals)
+{
+	std::vector<cv::Mat> out(kDirectionBins);
+	const double bin_deg = 180.0 / kDirectionBins;
+	for (int b = 0; b < kDirectionBins; ++b)
 	{
-		const int* l = labels.ptr<int>(y);
-		uint8_t* o = out.ptr<uint8_t>(y);
-		for (int x = 0; x < classes.cols; ++x)
-			if (l[x] > 0 && size_t(l[x]) < normal_of_label.size()) o[x] = normal_of_label[size_t(l[x])];
+		cv::Mat not_wall(normals.size(), CV_8U, cv::Scalar(255));
+		for (int y = 0; y < normals.rows; ++y)
+		{
+			const uint8_t* n = normals.ptr<uint8_t>(y);
+			uint8_t* o = not_wall.ptr<uint8_t>(y);
+			for (int x = 0; x < normals.cols; ++x)
+				if (n[x] != kNoDirection && std::abs(std::remainder(double(n[x]) - b * bin_deg, 180.0)) <= kBinHalfWidthDeg)
+					o[x] = 0;
+		}
+		cv::Mat dist;
+		cv::distanceTransform(not_wall, dist, cv::DIST_L2, cv::DIST_MASK_3);
+		dist.convertTo(out[size_t(b)], CV_8U);
 	}
 	return out;
 }
@@ -124,7 +132,9 @@ OccupancyField occupancyField(const cv::Mat& classes)
 	cv::distanceTransform(classes != kOccupied, f.dist_to_occupied, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 	cv::distanceTransform(classes == kFree, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 	f.known = classes != kUnknown;
-	f.nearest_wall_normal_deg = nearestWallNormal(classes);
+	const cv::Mat occupied = classes == kOccupied;
+	f.wall_normal_deg = wallNormals(occupied);
+	f.dist_to_wall_by_direction = distanceToWallByDirection(f.wall_normal_deg);
 	return f;
 }
 
@@ -144,7 +154,8 @@ Support tolerantSupport(
 	const int w = target.known.cols, h = target.known.rows;
 	const Eigen::Matrix2d a = t.linear();
 	const double turn_deg = t.yaw * 180.0 / M_PI;
-	const bool directions = !source.nearest_wall_normal_deg.empty() && !target.nearest_wall_normal_deg.empty();
+	const bool directions =
+		!source.wall_normal_deg.empty() && target.dist_to_wall_by_direction.size() == size_t(kDirectionBins);
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
@@ -158,21 +169,28 @@ Support tolerantSupport(
 			++s.judged, ++s.supported;
 			if (!directions) continue;
 			const int px = static_cast<int>(std::lround(p.x())), py = static_cast<int>(std::lround(p.y()));
-			if (px < 0 || py < 0 || px >= source.nearest_wall_normal_deg.cols || py >= source.nearest_wall_normal_deg.rows)
+			if (px < 0 || py < 0 || px >= source.wall_normal_deg.cols || py >= source.wall_normal_deg.rows)
 				continue;
-			const uint8_t ds = source.nearest_wall_normal_deg.at<uint8_t>(py, px);
-			const uint8_t dt = target.nearest_wall_normal_deg.at<uint8_t>(y, x);
-			if (ds == kNoDirection || dt == kNoDirection) continue;
-			++s.oriented;
-			const double diff = std::abs(std::remainder(double(ds) + turn_deg - double(dt), 180.0));
-			s.aligned += diff <= 20.0;
+			const uint8_t ds = source.wall_normal_deg.at<uint8_t>(py, px);
+			if (ds == kNoDirection) continue;
+			// Near a wall running the same way, not merely near a wall (a
+			// wall crossing it, at a junction or by a wrong transform).
+			double moved = std::fmod(double(ds) + turn_deg, 180.0);
+			if (moved < 0) moved += 180;
+			const int bin = int(std::lround(moved / (180.0 / kDirectionBins))) % kDirectionBins;
+			// Judged only near a wall that has a direction: walls drawn as
+			// speckle or clutter (no line to follow) say nothing either way.
+			bool near_directed = false;
+			for (const cv::Mat& d : target.dist_to_wall_by_direction)
+				near_directed = near_directed || d.at<uint8_t>(y, x) <= tolerance;
+			if (!near_directed) continue;
+			++s.directed;
+			s.directed_supported += target.dist_to_wall_by_direction[size_t(bin)].at<uint8_t>(y, x) <= tolerance;
 		}
 		else if (target.known.at<uint8_t>(y, x))
 		{
 			++s.judged;
-			const float free_depth = target.dist_to_not_free.at<float>(y, x);
-			s.conflicts += free_depth > tolerance;
-			s.deep_conflicts += free_depth > 3 * tolerance;
+			s.conflicts += target.dist_to_not_free.at<float>(y, x) > tolerance;
 		}
 	}
 	return s;

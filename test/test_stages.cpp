@@ -196,42 +196,49 @@ TEST(MapAgreement, TolerantConsistencyIsAPeakAboveChance)
 	EXPECT_LT(far.consistency(), at_truth.consistency() - 0.15);
 }
 
-TEST(MapAgreement, WallNormalsAreCarriedFromTheNearestWall)
+TEST(MapAgreement, WallNormalsAndTheDistanceToWallsOfEachDirection)
 {
-	// A horizontal wall (normal along y) and a vertical one (normal along x)
-	// meeting it in a T: every cell gets the normal of the wall nearest to
-	// it; the junction has none.
+	// A horizontal wall (normal along y, 90°) and a vertical one (normal
+	// along x, 0°) meeting it in a T: each wall cell has its normal, the
+	// junction none; each direction's distance sees only its own walls.
 	cv::Mat classes(60, 60, CV_8U, cv::Scalar(kFree));
 	classes.row(10).setTo(kOccupied);
 	classes(cv::Rect(45, 10, 1, 50)).setTo(kOccupied);
-	const cv::Mat normal = occupancyField(classes).nearest_wall_normal_deg;
-	EXPECT_NEAR(normal.at<uint8_t>(14, 20), 90, 1);
-	EXPECT_NEAR(normal.at<uint8_t>(10, 30), 90, 1);
-	const int vertical = normal.at<uint8_t>(40, 50);
+	const OccupancyField f = occupancyField(classes);
+	EXPECT_NEAR(f.wall_normal_deg.at<uint8_t>(10, 20), 90, 1);
+	const int vertical = f.wall_normal_deg.at<uint8_t>(40, 45);
 	EXPECT_TRUE(vertical <= 1 || vertical >= 179) << vertical;
-	EXPECT_EQ(normal.at<uint8_t>(10, 45), kNoDirection) << "a T junction runs no one way";
+	EXPECT_EQ(f.wall_normal_deg.at<uint8_t>(10, 45), kNoDirection) << "a T junction runs no one way";
+	EXPECT_EQ(f.wall_normal_deg.at<uint8_t>(30, 20), kNoDirection) << "free space has no wall";
+	ASSERT_EQ(f.dist_to_wall_by_direction.size(), size_t(kDirectionBins));
+	const size_t normal_along_y = kDirectionBins / 2, normal_along_x = 0;
+	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_y].at<uint8_t>(14, 20), 4, 1);
+	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_x].at<uint8_t>(14, 20), 25, 1);
+	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_x].at<uint8_t>(40, 50), 5, 1);
 }
 
 TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 {
 	// At the truth (and with walls bent by two cells) the walls lying near
-	// the other map's walls run the same way; turned by 45° about the map's
-	// centre, the walls that still lie near walls cross them.
+	// the other map's walls lie near walls running the same way; turned by
+	// 45° about the map's centre, the walls that still lie near walls cross
+	// them.
 	const auto pair = malaga5and10();
 	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
 	const PointList ea = edgePoints(a), eb = edgePoints(b);
 	const OccupancyField fa = occupancyField(a), fb = occupancyField(b);
 	const Similarity2D truth = pair.otherCellsToRefCells();
 	const TwoWaySupport at_truth = twoWaySupport(ea, fa, eb, fb, truth, 3.0);
-	EXPECT_GT(at_truth.alignment(), 0.9);
-	EXPECT_GT(at_truth.other_in_ref.oriented, 300u);
+	EXPECT_GT(at_truth.wallAlignment(), 0.8);
+	EXPECT_GT(at_truth.other_in_ref.directed, 300u);
 	const TwoWaySupport bent = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {4, 0}).compose(truth), 3.0);
-	EXPECT_GT(bent.alignment(), 0.85);
+	EXPECT_GT(bent.wallAlignment(), 0.8);
 	const Eigen::Vector2d centre(a.cols / 2.0, a.rows / 2.0);
 	Similarity2D turn(1, M_PI / 4, {0, 0});
 	turn.t = centre - turn.apply(centre);
 	const TwoWaySupport turned = twoWaySupport(ea, fa, eb, fb, turn.compose(truth), 3.0);
-	EXPECT_LT(turned.alignment(), 0.5);
+	EXPECT_LT(turned.wallAlignment(), 0.5);
+	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 100u) << "turned walls still lie near walls";
 }
 
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)

@@ -110,7 +110,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 400;
+		double decision_evidence = 200;
 		/** The best candidate merges on its walls only if they agree more
 		 * than chance by at least this (tolerant consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
@@ -127,17 +127,17 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 1.0;
+		double decision_runner_up_weight = 4.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
-		double decision_runner_up_floor = 0.0;
+		double decision_runner_up_floor = 0.25;
 		/** Candidates whose other-map wall centroids lie more than this many
 		 * coarse cells apart (or turned by over verify_turn_deg, or scaled by
 		 * over 10 %) are rivals, not one answer. */
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.397;
+		double decision_threshold = 0.800;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -193,10 +193,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double tolerant_consistency = 0, chance_consistency = 0;
 		double support = 0;  //!< share of wall points near a wall of the other map
 		double chance_support = 0;  //!< the best support under the same far perturbations
-		/** The tolerant consistency counting only conflicts deep in free
-		 * space, and the share of supported wall points whose wall directions
-		 * agree (MapAgreement.h, TwoWaySupport). */
-		double deep_consistency = 0, wall_alignment = 0;
+		/** Of the wall points near a wall of the other map, the share near
+		 * one running the same way (TwoWaySupport::wallAlignment). */
+		double wall_alignment = 0;
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;

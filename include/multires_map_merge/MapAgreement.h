@@ -9,6 +9,8 @@
 
 #include <opencv2/core.hpp>
 
+#include <vector>
+
 namespace multires_map_merge
 {
 struct Agreement
@@ -44,12 +46,15 @@ struct OccupancyField
 	cv::Mat dist_to_occupied;  //!< CV_32F, cells to the nearest occupied cell
 	cv::Mat dist_to_not_free;  //!< CV_32F, cells to the nearest occupied or unknown cell
 	cv::Mat known;  //!< CV_8U, non-zero where the map has seen the space
-	/** CV_8U: the direction (degrees, 0–179) of the wall normal at the
-	 * nearest occupied cell; kNoDirection where that wall has none (a corner,
-	 * a speck). */
-	cv::Mat nearest_wall_normal_deg;
+	/** CV_8U: the wall normal (degrees, 0–179) at each occupied cell,
+	 * kNoDirection elsewhere. */
+	cv::Mat wall_normal_deg;
+	/** kDirectionBins CV_8U images: cells (saturated at 255) to the nearest
+	 * wall whose normal lies within 20° of bin b's centre, b · 180° / bins. */
+	std::vector<cv::Mat> dist_to_wall_by_direction;
 };
 constexpr uint8_t kNoDirection = 255;
+constexpr int kDirectionBins = 6;
 OccupancyField occupancyField(const cv::Mat& classes);
 
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
@@ -63,12 +68,11 @@ struct Support
 	/** Of those, on free space farther than the tolerance from any wall or
 	 * unknown cell: a wall where the target clearly sees none. */
 	size_t conflicts = 0;
-	/** Of the conflicts, those farther than three tolerances from any wall
-	 * or unknown cell: not a bent wall. */
-	size_t deep_conflicts = 0;
-	/** Of the supported points, those where both walls have a direction, and
-	 * of these the ones whose directions agree within 20°. */
-	size_t oriented = 0, aligned = 0;
+	/** Of the supported points, those whose own wall has a direction (not
+	 * a corner or a speck) and that lie within the tolerance of a target
+	 * wall with a direction, and of these the ones within the tolerance of
+	 * a target wall running the same way (normals within about 20°). */
+	size_t directed = 0, directed_supported = 0;
 	double ratio() const { return judged ? double(supported) / double(judged) : 0.0; }
 };
 
@@ -97,18 +101,14 @@ struct TwoWaySupport
 		const size_t j = other_in_ref.judged + ref_in_other.judged;
 		return j ? 1.0 - double(other_in_ref.conflicts + ref_in_other.conflicts) / double(j) : 0.0;
 	}
-	/** The same with deep conflicts only. */
-	double deepConsistency() const
+	/** Wall alignment: of the supported points with a direction, over both
+	 * directions, the share near a wall of the other map running the same
+	 * way. A wrong transform lays walls across walls; T counts that as
+	 * agreement, this does not. */
+	double wallAlignment() const
 	{
-		const size_t j = other_in_ref.judged + ref_in_other.judged;
-		return j ? 1.0 - double(other_in_ref.deep_conflicts + ref_in_other.deep_conflicts) / double(j) : 0.0;
-	}
-	/** Share of supported points with directions on both walls whose
-	 * directions agree, over both directions. */
-	double alignment() const
-	{
-		const size_t o = other_in_ref.oriented + ref_in_other.oriented;
-		return o ? double(other_in_ref.aligned + ref_in_other.aligned) / double(o) : 0.0;
+		const size_t o = other_in_ref.directed + ref_in_other.directed;
+		return o ? double(other_in_ref.directed_supported + ref_in_other.directed_supported) / double(o) : 0.0;
 	}
 };
 
