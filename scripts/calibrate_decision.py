@@ -32,15 +32,16 @@ alignment of one building stands out, a chance fit between two buildings has
 rivals nearly as good. The other map's mirror image is aligned too (the
 aligner's mirror_check; rows with mirrored=1): each of its candidates is a
 rival and never the best, so a map against its own mirror image, which fits
-itself mirrored exactly, is refused. The pair is merged when value >= threshold, and only if its best candidate's
-T leads C by the minimum lead and its wall alignment A (the share of wall
-points near a wall of the other map whose wall runs the same way, within
-20 degrees) reaches the minimum wall alignment: independent maps of one
-building differ in where their walls are by a few cells, not in which way
-they run, while a wrong alignment lays walls across walls.
+itself mirrored exactly, is refused. The pair is merged when value >=
+threshold, and only if its best candidate's T leads C by the minimum lead
+and its wall alignment A (of the wall points near a wall of the other map
+that has a direction, the share near one running the same way, within
+about 20 degrees) reaches the minimum wall alignment: independent maps of
+one building differ in where their walls are by a few cells, not in which
+way they run, while a wrong alignment lays walls across walls.
 
-This script picks chance_weight, evidence, runner_up_weight, floor and the
-minimum lead (the most right merges; ties go to the smaller runner-up
+This script picks chance_weight, evidence, runner_up_weight, floor, the
+minimum lead and the minimum wall alignment (the most right merges; ties go to the smaller runner-up
 weight, then the larger chance weight, evidence, floor and minimum lead: the
 safer where it costs nothing) and sets threshold just above the highest
 value any pair whose best candidate is wrong reaches, plus a safety margin,

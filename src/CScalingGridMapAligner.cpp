@@ -582,8 +582,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// The decision's score of a transform, judged on at most `most` points
 	// per map; with fewer than the decision judges, the evidence discount is
 	// taken for the count the decision would judge.
+	// The wall alignment is judged in full only: a screen never decides.
 	auto decisionScore = [&](const Similarity2D& t, size_t most, TwoWaySupport& sup, Chance& chance) {
-		sup = twoWaySupport(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most);
+		sup = twoWaySupport(
+			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most, most >= kJudgedPoints);
 		chance = chanceSupport(
 			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, options.verify_shift,
 			options.verify_turn_deg, most);

@@ -66,30 +66,8 @@ cv::Mat wallNormals(const cv::Mat& occupied)
 	return out;
 }
 
-// Per direction bin, the distance (cells, saturated at 255) to the nearest
-// wall whose normal lies within kBinHalfWidthDeg of the bin's centre.
-constexpr double kBinHalfWidthDeg = 20.0;
-std::vector<cv::Mat> distanceToWallByDirection(const cv::Mat& normals)
-{
-	std::vector<cv::Mat> out(kDirectionBins);
-	const double bin_deg = 180.0 / kDirectionBins;
-	for (int b = 0; b < kDirectionBins; ++b)
-	{
-		cv::Mat not_wall(normals.size(), CV_8U, cv::Scalar(255));
-		for (int y = 0; y < normals.rows; ++y)
-		{
-			const uint8_t* n = normals.ptr<uint8_t>(y);
-			uint8_t* o = not_wall.ptr<uint8_t>(y);
-			for (int x = 0; x < normals.cols; ++x)
-				if (n[x] != kNoDirection && std::abs(std::remainder(double(n[x]) - b * bin_deg, 180.0)) <= kBinHalfWidthDeg)
-					o[x] = 0;
-		}
-		cv::Mat dist;
-		cv::distanceTransform(not_wall, dist, cv::DIST_L2, cv::DIST_MASK_3);
-		dist.convertTo(out[size_t(b)], CV_8U);
-	}
-	return out;
-}
+// Walls whose normals differ by at most this run the same way.
+constexpr double kSameDirectionDeg = 20.0;
 }  // namespace
 
 Agreement mapAgreement(
@@ -134,7 +112,6 @@ OccupancyField occupancyField(const cv::Mat& classes)
 	f.known = classes != kUnknown;
 	const cv::Mat occupied = classes == kOccupied;
 	f.wall_normal_deg = wallNormals(occupied);
-	f.dist_to_wall_by_direction = distanceToWallByDirection(f.wall_normal_deg);
 	return f;
 }
 
@@ -148,14 +125,15 @@ cv::Mat knownWithin(const cv::Mat& known, double cells)
 
 Support tolerantSupport(
 	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target,
-	double tolerance)
+	double tolerance, bool judge_directions)
 {
 	Support s;
 	const int w = target.known.cols, h = target.known.rows;
 	const Eigen::Matrix2d a = t.linear();
 	const double turn_deg = t.yaw * 180.0 / M_PI;
-	const bool directions =
-		!source.wall_normal_deg.empty() && target.dist_to_wall_by_direction.size() == size_t(kDirectionBins);
+	const bool directions = judge_directions && !source.wall_normal_deg.empty() && !target.wall_normal_deg.empty();
+	const int reach = static_cast<int>(std::floor(tolerance));
+	const double reach2 = tolerance * tolerance;
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
@@ -175,17 +153,27 @@ Support tolerantSupport(
 			if (ds == kNoDirection) continue;
 			// Near a wall running the same way, not merely near a wall (a
 			// wall crossing it, at a junction or by a wrong transform).
-			double moved = std::fmod(double(ds) + turn_deg, 180.0);
-			if (moved < 0) moved += 180;
-			const int bin = int(std::lround(moved / (180.0 / kDirectionBins))) % kDirectionBins;
 			// Judged only near a wall that has a direction: walls drawn as
 			// speckle or clutter (no line to follow) say nothing either way.
-			bool near_directed = false;
-			for (const cv::Mat& d : target.dist_to_wall_by_direction)
-				near_directed = near_directed || d.at<uint8_t>(y, x) <= tolerance;
+			const double moved = double(ds) + turn_deg;
+			bool near_directed = false, near_same = false;
+			for (int v = std::max(0, y - reach); v <= std::min(h - 1, y + reach) && !near_same; ++v)
+			{
+				const uint8_t* row = target.wall_normal_deg.ptr<uint8_t>(v);
+				for (int u = std::max(0, x - reach); u <= std::min(w - 1, x + reach); ++u)
+				{
+					if (row[u] == kNoDirection || double((u - x) * (u - x) + (v - y) * (v - y)) > reach2) continue;
+					near_directed = true;
+					if (std::abs(std::remainder(double(row[u]) - moved, 180.0)) <= kSameDirectionDeg)
+					{
+						near_same = true;
+						break;
+					}
+				}
+			}
 			if (!near_directed) continue;
 			++s.directed;
-			s.directed_supported += target.dist_to_wall_by_direction[size_t(bin)].at<uint8_t>(y, x) <= tolerance;
+			s.directed_supported += near_same;
 		}
 		else if (target.known.at<uint8_t>(y, x))
 		{
@@ -210,17 +198,19 @@ PointList thinned(const PointList& pts, size_t most)
 
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most)
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most,
+	bool judge_directions)
 {
 	TwoWaySupport s;
 	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return s;
 	// One coarse cell, in each map's own cells.
 	const double coarse_in_ref = std::max(1.0, other_to_ref.scale);
 	const double coarse_in_other = std::max(1.0, 1.0 / other_to_ref.scale);
-	s.other_in_ref =
-		tolerantSupport(thinned(other_points, most), other_field, other_to_ref, ref_field, tol_coarse * coarse_in_ref);
+	s.other_in_ref = tolerantSupport(
+		thinned(other_points, most), other_field, other_to_ref, ref_field, tol_coarse * coarse_in_ref, judge_directions);
 	s.ref_in_other = tolerantSupport(
-		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other);
+		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other,
+		judge_directions);
 	return s;
 }
 
@@ -248,7 +238,7 @@ Chance chanceSupport(
 	for (const auto& m : moves)
 	{
 		const TwoWaySupport s =
-			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tol_coarse, most);
+			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tol_coarse, most, false);
 		best.support = std::max(best.support, s.score());
 		best.consistency = std::max(best.consistency, s.consistency());
 	}

@@ -175,32 +175,44 @@ TEST(MapAgreement, HighAtTruthLowWhenShifted)
 	EXPECT_GT(good.occupied_overlap, 1000u);
 }
 
+namespace
+{
+// The malaga pair's wall points and fields, judged under the truth moved by
+// `move` (reference cells).
+struct MalagaSupport
+{
+	GroundTruthPair pair = malaga5and10();
+	cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
+	PointList ea = edgePoints(a), eb = edgePoints(b);
+	OccupancyField fa = occupancyField(a), fb = occupancyField(b);
+	Similarity2D truth = pair.otherCellsToRefCells();
+	TwoWaySupport at(const Similarity2D& move = Similarity2D()) const
+	{
+		return twoWaySupport(ea, fa, eb, fb, move.compose(truth), 3.0);
+	}
+};
+}  // namespace
+
 TEST(MapAgreement, TolerantConsistencyIsAPeakAboveChance)
 {
 	// At the truth the walls agree and beat the same transform moved far
 	// away; moved far away they do not.
-	const auto pair = malaga5and10();
-	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
-	const PointList ea = edgePoints(a), eb = edgePoints(b);
-	const OccupancyField fa = occupancyField(a), fb = occupancyField(b);
-	const Similarity2D truth = pair.otherCellsToRefCells();
-	const TwoWaySupport at_truth = twoWaySupport(ea, fa, eb, fb, truth, 3.0);
-	const Chance chance = chanceSupport(ea, fa, eb, fb, truth, 3.0, 12.0, 8.0);
+	const MalagaSupport m;
+	const TwoWaySupport at_truth = m.at();
+	const Chance chance = chanceSupport(m.ea, m.fa, m.eb, m.fb, m.truth, 3.0, 12.0, 8.0);
 	EXPECT_GT(at_truth.consistency(), 0.9);
 	EXPECT_GT(at_truth.consistency(), chance.consistency + 0.1);
 	EXPECT_GT(at_truth.judged(), 500u);
 	// Bent walls (a 2-cell shift of the coarser map) still agree.
-	const TwoWaySupport bent = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {4, 0}).compose(truth), 3.0);
-	EXPECT_GT(bent.consistency(), 0.8);
-	const TwoWaySupport far = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {60, 0}).compose(truth), 3.0);
-	EXPECT_LT(far.consistency(), at_truth.consistency() - 0.15);
+	EXPECT_GT(m.at(Similarity2D(1, 0, {4, 0})).consistency(), 0.8);
+	EXPECT_LT(m.at(Similarity2D(1, 0, {60, 0})).consistency(), at_truth.consistency() - 0.15);
 }
 
-TEST(MapAgreement, WallNormalsAndTheDistanceToWallsOfEachDirection)
+TEST(MapAgreement, WallNormalsOfEachWallCell)
 {
 	// A horizontal wall (normal along y, 90°) and a vertical one (normal
 	// along x, 0°) meeting it in a T: each wall cell has its normal, the
-	// junction none; each direction's distance sees only its own walls.
+	// junction none, free space none.
 	cv::Mat classes(60, 60, CV_8U, cv::Scalar(kFree));
 	classes.row(10).setTo(kOccupied);
 	classes(cv::Rect(45, 10, 1, 50)).setTo(kOccupied);
@@ -210,11 +222,6 @@ TEST(MapAgreement, WallNormalsAndTheDistanceToWallsOfEachDirection)
 	EXPECT_TRUE(vertical <= 1 || vertical >= 179) << vertical;
 	EXPECT_EQ(f.wall_normal_deg.at<uint8_t>(10, 45), kNoDirection) << "a T junction runs no one way";
 	EXPECT_EQ(f.wall_normal_deg.at<uint8_t>(30, 20), kNoDirection) << "free space has no wall";
-	ASSERT_EQ(f.dist_to_wall_by_direction.size(), size_t(kDirectionBins));
-	const size_t normal_along_y = kDirectionBins / 2, normal_along_x = 0;
-	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_y].at<uint8_t>(14, 20), 4, 1);
-	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_x].at<uint8_t>(14, 20), 25, 1);
-	EXPECT_NEAR(f.dist_to_wall_by_direction[normal_along_x].at<uint8_t>(40, 50), 5, 1);
 }
 
 TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
@@ -223,20 +230,15 @@ TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 	// the other map's walls lie near walls running the same way; turned by
 	// 45° about the map's centre, the walls that still lie near walls cross
 	// them.
-	const auto pair = malaga5and10();
-	const cv::Mat a = toClassImage(pair.ref), b = toClassImage(pair.other);
-	const PointList ea = edgePoints(a), eb = edgePoints(b);
-	const OccupancyField fa = occupancyField(a), fb = occupancyField(b);
-	const Similarity2D truth = pair.otherCellsToRefCells();
-	const TwoWaySupport at_truth = twoWaySupport(ea, fa, eb, fb, truth, 3.0);
+	const MalagaSupport m;
+	const TwoWaySupport at_truth = m.at();
 	EXPECT_GT(at_truth.wallAlignment(), 0.8);
 	EXPECT_GT(at_truth.other_in_ref.directed, 300u);
-	const TwoWaySupport bent = twoWaySupport(ea, fa, eb, fb, Similarity2D(1, 0, {4, 0}).compose(truth), 3.0);
-	EXPECT_GT(bent.wallAlignment(), 0.8);
-	const Eigen::Vector2d centre(a.cols / 2.0, a.rows / 2.0);
+	EXPECT_GT(m.at(Similarity2D(1, 0, {4, 0})).wallAlignment(), 0.8);
+	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
 	Similarity2D turn(1, M_PI / 4, {0, 0});
 	turn.t = centre - turn.apply(centre);
-	const TwoWaySupport turned = twoWaySupport(ea, fa, eb, fb, turn.compose(truth), 3.0);
+	const TwoWaySupport turned = m.at(turn);
 	EXPECT_LT(turned.wallAlignment(), 0.5);
 	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 100u) << "turned walls still lie near walls";
 }

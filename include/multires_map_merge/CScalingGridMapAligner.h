@@ -122,12 +122,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * the same way as that wall (within 20°): a wrong alignment puts
 		 * walls across walls as often as along them, and a map's walls lying
 		 * near the other's by chance mostly cross them. Calibrated. */
-		double decision_min_wall_alignment = 0.77;
+		double decision_min_wall_alignment = 0.80;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 4.0;
+		double decision_runner_up_weight = 1.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.25;
@@ -137,7 +137,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.800;
+		double decision_threshold = 0.464;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */

@@ -49,12 +49,8 @@ struct OccupancyField
 	/** CV_8U: the wall normal (degrees, 0–179) at each occupied cell,
 	 * kNoDirection elsewhere. */
 	cv::Mat wall_normal_deg;
-	/** kDirectionBins CV_8U images: cells (saturated at 255) to the nearest
-	 * wall whose normal lies within 20° of bin b's centre, b · 180° / bins. */
-	std::vector<cv::Mat> dist_to_wall_by_direction;
 };
 constexpr uint8_t kNoDirection = 255;
-constexpr int kDirectionBins = 6;
 OccupancyField occupancyField(const cv::Mat& classes);
 
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
@@ -78,10 +74,13 @@ struct Support
 
 /** `points` (cells of the source map) moved by `source_to_target` (cells)
  * into the target map: how many land on its known space, and how many of
- * those within `tolerance` target cells of an occupied cell. */
+ * those within `tolerance` target cells of an occupied cell; with
+ * `judge_directions`, also whether those run like the walls near them
+ * (Support::directed; a search of the target's cells within the tolerance,
+ * so only where the wall alignment is wanted). */
 Support tolerantSupport(
 	const PointList& points, const OccupancyField& source, const Similarity2D& source_to_target,
-	const OccupancyField& target, double tolerance);
+	const OccupancyField& target, double tolerance, bool judge_directions = true);
 
 /** Wall points judged per map at most (evenly thinned): the ratios, not the
  * counts, matter. A screen judges fewer. */
@@ -115,7 +114,7 @@ struct TwoWaySupport
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
 	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
-	size_t most_points = kJudgedPoints);
+	size_t most_points = kJudgedPoints, bool judge_directions = true);
 
 /** The best two-way score under "far" perturbations of the transform: the
  * other map shifted by ±`shift_coarse_cells` along each axis and turned by
