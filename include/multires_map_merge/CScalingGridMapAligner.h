@@ -105,8 +105,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// Calibrated (scripts/calibrate_decision.py, bench/results/calibration.txt)
 		// on E5/HIH pairs, cross-site, CARMEN, mirror and live-fleet data (growing
 		// partial maps of two buildings: without them a fit placed intel's robot
-		// in fr079), two samples of it made on two machines (their hypotheses,
-		// hence rivals, differ): no wrong calibration candidate passes in either.
+		// in fr079), made by this code with these defaults: no wrong calibration
+		// candidate passes, with a margin (README, "How the decision works").
 		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
@@ -118,10 +118,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * few rivals they have. */
 		double decision_min_lead = 0.04;
 		/** The best candidate merges on its walls only if at least this
-		 * share of the wall points lying near a wall of the other map run
-		 * the same way as that wall (within 20°): a wrong alignment puts
-		 * walls across walls as often as along them, and a map's walls lying
-		 * near the other's by chance mostly cross them. Calibrated. */
+		 * share of its wall points lying near a directed wall of the other
+		 * map lie near one running the same way (within 20°;
+		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
+		 * walls, which the tolerant consistency counts as agreement. */
 		double decision_min_wall_alignment = 0.80;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):

@@ -9,8 +9,6 @@
 
 #include <opencv2/core.hpp>
 
-#include <vector>
-
 namespace multires_map_merge
 {
 struct Agreement
