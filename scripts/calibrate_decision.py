@@ -38,15 +38,23 @@ and its wall alignment A (of the wall points near a wall of the other map
 that has a direction, the share near one running the same way, within
 about 20 degrees) reaches the minimum wall alignment: independent maps of
 one building differ in where their walls are by a few cells, not in which
-way they run, while a wrong alignment lays walls across walls.
+way they run, while a wrong alignment lays walls across walls. Nor unless
+its shift coherence H (tiles of 30 coarse cells of the moved walls, each
+given the small shift, within 8 coarse cells, that fits it best: the share
+of adjacent tiles whose shifts agree within the tolerance) reaches the
+minimum: SLAM bends a map smoothly, a wrong alignment that lays walls near
+walls fits each region by a shift of its own.
 
 This script picks chance_weight, evidence, runner_up_weight, floor, the
-minimum lead and the minimum wall alignment (the most right merges; ties go to the smaller runner-up
-weight, then the larger chance weight, evidence, floor and minimum lead: the
-safer where it costs nothing) and sets threshold just above the highest
-value any pair whose best candidate is wrong reaches, plus a safety margin,
-so that no calibration pair would be merged wrong, and treats a wrong pair
-just below a gate (ALIGNMENT_MARGIN, LEAD_MARGIN) as through it. It prints
+minimum lead, the minimum wall alignment and the minimum shift coherence
+(the most right merges; ties go to the smaller runner-up weight, then the
+larger chance weight, evidence, floor, minimum lead, wall alignment and
+shift coherence: the safer where it costs nothing; a coherence gate must
+stay COHERENCE_MARGIN below every right best candidate's) and sets
+threshold just above the highest value any pair whose best candidate is
+wrong reaches, plus a safety margin, so that no calibration pair would be
+merged wrong, and treats a wrong pair just below a gate (ALIGNMENT_MARGIN,
+LEAD_MARGIN, COHERENCE_MARGIN) as through it. It prints
 the ini keys.
 
 Each CSV given is a sample of its own: the same pair aligned by another
@@ -84,15 +92,22 @@ MARGIN = 0.05
 # the threshold as if it had passed.
 ALIGNMENT_MARGIN = 0.02
 LEAD_MARGIN = 0.01
+COHERENCE_MARGIN = 0.02
 WEIGHTS = [0.5, 1.0, 1.5]
 EVIDENCE = [200, 400, 1000]
 RUNNER_UP = [0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0]
+# No floor above 0.25: right best candidates score about 0.3-0.6 (median
+# 0.44), and a floor above a pair's score silences its rivals, however
+# close (a floor of 0.5 fits two more calibration pairs by merging pairs
+# whose best candidate has a rival at nearly its own score).
 FLOORS = [-0.5, 0.0, 0.25]
 # decision_min_lead: the best candidate's tolerant consistency must exceed
 # chance by this to merge on its walls.
 LEADS = [0.0, 0.02, 0.04]
 # decision_min_wall_alignment (0: no gate).
 ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.77, 0.78, 0.8]
+# decision_min_shift_coherence (0: no gate).
+COHERENCES = [0.0, 0.2, 0.25, 0.3]
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
@@ -125,6 +140,7 @@ def load(paths):
                     "C": float(r["chance_consistency"]),
                     # Absent from data written before it was measured: no gate there.
                     "A": float(r.get("wall_alignment") or "nan"),
+                    "H": float(r.get("shift_coherence") or "nan"),
                     "n": max(1, int(r["judged"])),
                     "scale": float(r["scale"]),
                     "yaw": math.radians(float(r["yaw_deg"])),
@@ -171,18 +187,25 @@ def main():
                 judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
                 if judged:
                     tops[key] = max(judged, key=lambda r: scores[id(r)])
-            for k, floor, lead, align in itertools.product(RUNNER_UP, FLOORS, LEADS, ALIGNMENTS):
+            # A coherence gate is for the wrong tops: one that some right best
+            # candidate does not clear by the margin would trim merges of new
+            # maps for no gain here.
+            right_tops = [tops[key]["H"] for key in positives if key in tops and tops[key]["right"]]
+            cohs = [h for h in COHERENCES if not right_tops or h <= min(right_tops) - COHERENCE_MARGIN]
+            for k, floor, lead, align, coh in itertools.product(RUNNER_UP, FLOORS, LEADS, ALIGNMENTS, cohs):
                 def value(top):
                     s = scores[id(top)]
                     rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
                     return s + k * (s - rival)
-                # A top not leading chance by `lead`, or whose near walls run
-                # alike less than `align`, cannot merge: below any threshold.
-                # Wrong tops within the gates' margins count as through them.
-                def through(top, lead_margin, align_margin):
-                    return top["T"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
-                values = {key: value(top) if through(top, 0, 0) else -math.inf for key, top in tops.items()}
-                wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN) else -math.inf
+                # A top not leading chance by `lead`, whose near walls run
+                # alike less than `align`, or whose regions shift alike less
+                # than `coh`, cannot merge: below any threshold. Wrong tops
+                # within the gates' margins count as through them.
+                def through(top, lead_margin, align_margin, coh_margin):
+                    return (top["T"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
+                            and not top["H"] < coh - coh_margin)
+                values = {key: value(top) if through(top, 0, 0, 0) else -math.inf for key, top in tops.items()}
+                wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN, COHERENCE_MARGIN) else -math.inf
                          for key, top in tops.items() if not top["right"] and not top["near"]]
                 threshold = max(wrong) + MARGIN * (1 + k)
                 merged_right = sum(1 for key in positives
@@ -190,17 +213,17 @@ def main():
                 live_right = sum(1 for key in live
                                  if key in tops and tops[key]["right"] and values[key] >= threshold)
                 print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f} "
-                      f"alignment {align:4.2f}: "
+                      f"alignment {align:4.2f} coherence {coh:4.2f}: "
                       f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
                       f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
-                rank = (merged_right, -k, w, e, floor, lead, align)
+                rank = (merged_right, -k, w, e, floor, lead, align, coh)
                 if best is None or rank > best[0]:
                     per_file = collections.Counter(
                         key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
-                    best = (rank, w, e, k, floor, lead, align, threshold, merged_right, live_right, per_file)
-    _, w, e, k, floor, lead, align, threshold, merged_right, live_right, per_file = best
+                    best = (rank, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file)
+    _, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file = best
     print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
-          f"decision_min_wall_alignment = {align}\n"
+          f"decision_min_wall_alignment = {align}\ndecision_min_shift_coherence = {coh}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "

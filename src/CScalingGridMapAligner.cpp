@@ -62,6 +62,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_lead, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_wall_alignment, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_min_shift_coherence, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_runner_up_floor, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(distinct_shift, double, c, s);
@@ -109,6 +110,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("decision_evidence", decision_evidence, 0, 1e6);
 	in("decision_min_lead", decision_min_lead, -1, 1);
 	in("decision_min_wall_alignment", decision_min_wall_alignment, 0, 1);
+	in("decision_min_shift_coherence", decision_min_shift_coherence, 0, 1);
 	in("decision_runner_up_weight", decision_runner_up_weight, 0, 100);
 	in("decision_runner_up_floor", decision_runner_up_floor, -10, 10);
 	in("distinct_shift", distinct_shift, 1, 1e4);
@@ -152,6 +154,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_lead, "Merged on its walls only if they agree more than chance by this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_wall_alignment, "Merged on its walls only if this share of near walls run alike");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_shift_coherence, "Merged on its walls only if this share of adjacent regions fit after alike shifts");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_weight, "Decision value = best score + w (it - best distinct rival's score)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_runner_up_floor, "A rival scoring below this counts as this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(distinct_shift, "Candidates this far apart are rivals [coarse cells]");
@@ -193,6 +196,17 @@ bool CScalingGridMapAligner::TConfigParams::leadsChance(double tolerant_consiste
 bool CScalingGridMapAligner::TConfigParams::wallsRunAlike(double wall_alignment) const
 {
 	return wall_alignment >= decision_min_wall_alignment;
+}
+
+bool CScalingGridMapAligner::TConfigParams::shiftsCohere(double shift_coherence) const
+{
+	return shift_coherence >= decision_min_shift_coherence;
+}
+
+bool CScalingGridMapAligner::mayMergeOnWalls(const TCandidate& c) const
+{
+	return options.leadsChance(c.tolerant_consistency, c.chance_consistency) &&
+		options.wallsRunAlike(c.wall_alignment) && options.shiftsCohere(c.shift_coherence);
 }
 
 double CScalingGridMapAligner::TConfigParams::lowestMergeableScore() const
@@ -732,6 +746,11 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
+		// A mirrored candidate is only ever a rival (its score counts, not its gates).
+		if (!mirror_pass)
+			cand.shift_coherence =
+				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance)
+					.coherence();
 		// The first way to be sure (the maps coincide cell for cell) is this
 		// candidate's alone; the second is the pair's (decide, below). Both
 		// need walls enough to judge: a map squeezed into a few cells (TsICP
@@ -760,10 +779,6 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// confidence (a rival scores at most as much, so the decision value is at
 	// least the score; one scoring more would itself be merged). Searching on
 	// is then only time: independent maps never get there (calibration data).
-	auto mayMergeOnWalls = [&](const TCandidate& c) {
-		return options.leadsChance(c.tolerant_consistency, c.chance_consistency) &&
-			options.wallsRunAlike(c.wall_alignment);
-	};
 	auto mergedWhateverComes = [&](const TCandidate& c, double exact_needed) {
 		return c.exact_confidence >= exact_needed ||
 			(!c.screened && c.judged_points >= kMinJudgedPoints && c.score >= options.decision_runner_up_floor &&
@@ -819,6 +834,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.consistency = cand.tolerant_consistency;
 		info.chance_consistency = cand.chance_consistency;
 		info.wall_alignment = cand.wall_alignment;
+		info.shift_coherence = cand.shift_coherence;
 		info.score = cand.score;
 		info.runner_up_score = cand.runner_up_score;
 		info.decision_value = cand.decision_value;
@@ -1013,6 +1029,9 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (std::isfinite(info.decision_value) && !options.wallsRunAlike(info.wall_alignment))
 			why << ", walls near the other map's running alike in only " << info.wall_alignment
 				<< " of the cases (decision_min_wall_alignment = " << options.decision_min_wall_alignment << ")";
+		if (std::isfinite(info.decision_value) && !options.shiftsCohere(info.shift_coherence))
+			why << ", its regions fitting best after shifts alike in only " << info.shift_coherence
+				<< " of adjacent ones (decision_min_shift_coherence = " << options.decision_min_shift_coherence << ")";
 		why << ", overlap " << info.overlap << ", edge RMSE " << info.trimmed_rmse_coarse_cells << " cells)";
 		if (info.mirror_score > info.score)
 			why << "; the other map fits better mirrored (score " << info.mirror_score

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <map>
+#include <tuple>
 #include <vector>
 
 namespace multires_map_merge
@@ -212,6 +215,88 @@ TwoWaySupport twoWaySupport(
 		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other,
 		judge_directions);
 	return s;
+}
+
+ShiftField shiftField(
+	const PointList& points, const Similarity2D& t, const OccupancyField& target, double tolerance, double tile,
+	double reach, double step)
+{
+	ShiftField f;
+	const int w = target.known.cols, h = target.known.rows;
+	const Eigen::Matrix2d a = t.linear();
+	std::map<std::pair<int, int>, std::vector<cv::Point>> tiles;
+	for (const auto& p : points)
+	{
+		const Eigen::Vector2d q = a * p + t.t;
+		if (!(q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach)) continue;
+		tiles[{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))}].emplace_back(
+			int(std::lround(q.x())), int(std::lround(q.y())));
+	}
+	// Fewer points than this fit some shift by chance: the tile says nothing.
+	constexpr size_t kMinTilePoints = 12;
+	const int steps = std::max(0, int(std::floor(reach / step)));
+	std::map<std::pair<int, int>, cv::Point> best_shift;
+	for (const auto& [key, pts] : tiles)
+	{
+		if (pts.size() < kMinTilePoints) continue;
+		long best_value = std::numeric_limits<long>::min();
+		int best_norm = 0;
+		bool judged = false;
+		cv::Point best(0, 0);
+		for (int iy = -steps; iy <= steps; ++iy)
+			for (int ix = -steps; ix <= steps; ++ix)
+			{
+				const cv::Point d(int(std::lround(ix * step)), int(std::lround(iy * step)));
+				long value = 0;
+				bool any = false;
+				for (const auto& p : pts)
+				{
+					const int x = p.x + d.x, y = p.y + d.y;
+					if (x < 0 || y < 0 || x >= w || y >= h) continue;
+					if (target.dist_to_occupied.at<float>(y, x) <= tolerance)
+						++value, any = true;
+					else if (target.known.at<uint8_t>(y, x))
+					{
+						any = true;
+						value -= target.dist_to_not_free.at<float>(y, x) > tolerance;
+					}
+				}
+				const int norm = d.x * d.x + d.y * d.y;
+				if (any && (value > best_value || (value == best_value && norm < best_norm)))
+					best_value = value, best_norm = norm, best = d, judged = true;
+			}
+		if (!judged) continue;
+		++f.tiles;
+		best_shift[key] = best;
+	}
+	for (const auto& [key, d] : best_shift)
+		for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}})
+		{
+			const auto it = best_shift.find({key.first + dx, key.second + dy});
+			if (it == best_shift.end()) continue;
+			++f.neighbour_pairs;
+			f.coherent_pairs += std::hypot(double(it->second.x - d.x), double(it->second.y - d.y)) <= tolerance;
+		}
+	return f;
+}
+
+TwoWayShiftField twoWayShiftField(
+	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most)
+{
+	TwoWayShiftField f;
+	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return f;
+	// Tolerance, tile, reach and step in coarse cells, in each map's own cells.
+	for (const auto& [points, field, t, out] :
+		 {std::tuple{&other_points, &ref_field, other_to_ref, &f.other_in_ref},
+		  std::tuple{&ref_points, &other_field, other_to_ref.inverse(), &f.ref_in_other}})
+	{
+		const double coarse = std::max(1.0, t.scale);  // target cells per coarse cell
+		*out = shiftField(
+			thinned(*points, most), t, *field, tol_coarse * coarse, kShiftTileCoarseCells * coarse,
+			kShiftReachCoarseCells * coarse, coarse);
+	}
+	return f;
 }
 
 Chance chanceSupport(

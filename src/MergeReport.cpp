@@ -34,6 +34,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"consistency", num(r.consistency)},
 		{"chance_consistency", num(r.chance_consistency)},
 		{"wall_alignment", num(r.wall_alignment)},
+		{"shift_coherence", num(r.shift_coherence)},
 		{"score", num(r.score)},
 		{"runner_up_score", num(r.runner_up_score)},
 		{"decision_value", num(r.decision_value)},

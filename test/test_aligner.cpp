@@ -347,9 +347,11 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	CScalingGridMapAligner gated, ungated;
 	gated.options.decision_threshold = ungated.options.decision_threshold = 0.3;
 	ungated.options.decision_min_lead = 0;
-	// Its walls near the other map's also run alike too rarely (the wall
-	// alignment gate refuses it as well): off here, to see the lead gate.
+	// Its walls near the other map's also run alike too rarely, and its
+	// regions fit by shifts of their own (the wall-alignment and
+	// shift-coherence gates refuse it as well): off here, to see the lead gate.
 	gated.options.decision_min_wall_alignment = ungated.options.decision_min_wall_alignment = 0;
+	gated.options.decision_min_shift_coherence = ungated.options.decision_min_shift_coherence = 0;
 	const auto r = gated.alignScaled(ref, other), u = ungated.alignScaled(ref, other);
 	EXPECT_FALSE(r.success) << r.message;
 	EXPECT_LT(r.consistency - r.chance_consistency, gated.options.decision_min_lead);

@@ -112,7 +112,8 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		EXPECT_DOUBLE_EQ(best->runner_up_score, rival);
 		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision_runner_up_weight * (best->score - rival));
 		const bool walls_may_merge = o.leadsChance(best->tolerant_consistency, best->chance_consistency) &&
-			o.wallsRunAlike(best->wall_alignment);
+			o.wallsRunAlike(best->wall_alignment) && o.shiftsCohere(best->shift_coherence);
+		EXPECT_EQ(walls_may_merge, aligner.mayMergeOnWalls(*best));
 		EXPECT_EQ(res.success, walls_may_merge && best->decision_value >= o.decision_threshold);
 		if (res.success)
 		{
@@ -123,6 +124,8 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 			EXPECT_NE(res.message.find("best rival"), std::string::npos) << res.message;
 			if (!o.wallsRunAlike(best->wall_alignment))
 				EXPECT_NE(res.message.find("running alike"), std::string::npos) << res.message;
+			if (!o.shiftsCohere(best->shift_coherence))
+				EXPECT_NE(res.message.find("shifts alike"), std::string::npos) << res.message;
 		}
 	}
 }

@@ -243,6 +243,40 @@ TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 100u) << "turned walls still lie near walls";
 }
 
+TEST(MapAgreement, RegionsShiftAlikeUnderTheTruthNotWhenTurned)
+{
+	// The other map bent smoothly (a wave of up to 4 of its cells across the
+	// map, as SLAM bends walls): under the truth its regions fit best after
+	// shifts that vary smoothly. Turned by 45° about the map's centre, walls
+	// still lie near walls here and there, each region by a shift of its own.
+	const MalagaSupport m;
+	cv::Mat map_x(m.b.size(), CV_32F), map_y(m.b.size(), CV_32F);
+	for (int y = 0; y < m.b.rows; ++y)
+		for (int x = 0; x < m.b.cols; ++x)
+		{
+			map_x.at<float>(y, x) = float(x + 4.0 * std::sin(2 * M_PI * y / m.b.rows));
+			map_y.at<float>(y, x) = float(y + 4.0 * std::sin(2 * M_PI * x / m.b.cols));
+		}
+	cv::Mat bent;
+	cv::remap(m.b, bent, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(kUnknown));
+	const PointList bent_edges = edgePoints(bent);
+	const OccupancyField bent_field = occupancyField(bent);
+	auto coherence = [&](const Similarity2D& t) {
+		return twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, t, 3.0).coherence();
+	};
+	const TwoWayShiftField at_truth = twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, m.truth, 3.0);
+	EXPECT_GT(at_truth.coherence(), 0.6);
+	EXPECT_GT(at_truth.other_in_ref.neighbour_pairs + at_truth.ref_in_other.neighbour_pairs, 20u);
+	EXPECT_GT(twoWaySupport(m.ea, m.fa, bent_edges, bent_field, m.truth, 3.0).consistency(), 0.7)
+		<< "bent, yet the walls still lie near each other";
+	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
+	Similarity2D turn(1, M_PI / 4, {0, 0});
+	turn.t = centre - turn.apply(centre);
+	EXPECT_LT(coherence(turn.compose(m.truth)), 0.3);
+	// Slid 30 coarse cells (along corridors, some regions still fit alike).
+	EXPECT_LT(coherence(Similarity2D(1, 0, {60, 0}).compose(m.truth)), at_truth.coherence() - 0.3);
+}
+
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 {
 	// The same real map at 5 and 8 cm (rendered from the scans), the coarse

@@ -123,6 +123,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
 		double decision_min_wall_alignment = 0.80;
+		/** The best candidate merges on its walls only if at least this
+		 * share of adjacent tiles of its moved walls fit best after about the
+		 * same small shift (TwoWayShiftField::coherence): independent maps
+		 * bend smoothly, while a wrong alignment that lays walls near walls
+		 * fits each region by a shift of its own. */
+		double decision_min_shift_coherence = 0.25;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
@@ -173,6 +179,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Walls near each other run alike in at least
 		 * decision_min_wall_alignment of the cases. */
 		bool wallsRunAlike(double wall_alignment) const;
+		/** Regions of the walls fit after shifts alike in at least
+		 * decision_min_shift_coherence of adjacent tiles. */
+		bool shiftsCohere(double shift_coherence) const;
 
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
@@ -196,6 +205,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Of the wall points near a wall of the other map, the share near
 		 * one running the same way (TwoWaySupport::wallAlignment). */
 		double wall_alignment = 0;
+		/** Of adjacent tiles of the moved walls, the share whose best small
+		 * shifts agree (TwoWayShiftField::coherence; full judgement only). */
+		double shift_coherence = 0;
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
 		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
@@ -249,6 +261,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * the best of it under far perturbations (chance). */
 		double consistency = 0, chance_consistency = 0;
 		double wall_alignment = 0;  //!< TCandidate::wall_alignment of the chosen candidate
+		double shift_coherence = 0;  //!< TCandidate::shift_coherence of the chosen candidate
 		/** The chosen candidate's score, and where it is the pair's best-
 		 * scoring one, its best distinct rival's score and the decision value
 		 * (TCandidate; NaN otherwise). */
@@ -299,6 +312,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	 * elsewhere (its wall centroid more than distinct_shift coarse cells
 	 * apart, turned by more than verify_turn_deg, or scaled by over 10 %). */
 	bool areRivals(const TCandidate& a, const TCandidate& b) const;
+	/** The candidate's walls may decide a merge: they lead chance
+	 * (leadsChance), run alike (wallsRunAlike) and shift alike region by
+	 * region (shiftsCohere). */
+	bool mayMergeOnWalls(const TCandidate& c) const;
 
 	/** Prepares one map with these options. Never throws on bad content:
 	 * the map's `problem` says what is wrong. */

@@ -114,6 +114,52 @@ TwoWaySupport twoWaySupport(
 	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
 	size_t most_points = kJudgedPoints, bool judge_directions = true);
 
+/** Whether the walls agree region by region the same way. SLAM bends a map
+ * by a few cells, smoothly: under the right transform each tile of one map's
+ * moved walls fits the other's walls best after a small shift of its own,
+ * and neighbouring tiles want about the same shift. Under a wrong transform
+ * that happens to lay walls near walls, each tile's best shift goes its own
+ * way. */
+struct ShiftField
+{
+	size_t tiles = 0;  //!< tiles with wall points enough to fit a shift
+	size_t neighbour_pairs = 0;  //!< adjacent (8-neighbour) pairs of those
+	size_t coherent_pairs = 0;  //!< of which shifted alike (within the tolerance)
+};
+
+/** `points` (source cells) moved by `source_to_target` into the target,
+ * binned in square tiles of `tile` target cells; each tile's best shift
+ * (within ±`reach`, by `step`) is the one that puts the most points within
+ * `tolerance` of a target wall less those on the target's clearly free
+ * space (tolerantSupport's counts); ties go to the smaller shift. */
+ShiftField shiftField(
+	const PointList& points, const Similarity2D& source_to_target, const OccupancyField& target, double tolerance,
+	double tile, double reach, double step);
+
+/** Tiles of this many coarse cells, shifts within this reach: the bending of
+ * independent maps (a few cells over a room) without letting a tile slide
+ * onto the next corridor. */
+constexpr double kShiftTileCoarseCells = 30.0;
+constexpr double kShiftReachCoarseCells = 8.0;
+
+/** Both ways, for a transform between two maps' cells; `most_points` per
+ * map, thinned evenly, as twoWaySupport. */
+struct TwoWayShiftField
+{
+	ShiftField other_in_ref, ref_in_other;
+	/** Of adjacent tiles (both directions), the share whose best shifts
+	 * agree within the tolerance; 0 with no adjacent tiles. */
+	double coherence() const
+	{
+		const size_t n = other_in_ref.neighbour_pairs + ref_in_other.neighbour_pairs;
+		return n ? double(other_in_ref.coherent_pairs + ref_in_other.coherent_pairs) / double(n) : 0.0;
+	}
+};
+TwoWayShiftField twoWayShiftField(
+	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	size_t most_points = kJudgedPoints);
+
 /** The best two-way score under "far" perturbations of the transform: the
  * other map shifted by ±`shift_coarse_cells` along each axis and turned by
  * ±`turn_deg` about the centre of its points — what chance alone gives in
