@@ -596,10 +596,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// The decision's score of a transform, judged on at most `most` points
 	// per map; with fewer than the decision judges, the evidence discount is
 	// taken for the count the decision would judge.
-	// The wall alignment is judged in full only: a screen never decides.
-	auto decisionScore = [&](const Similarity2D& t, size_t most, TwoWaySupport& sup, Chance& chance) {
-		sup = twoWaySupport(
-			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most, most >= kJudgedPoints);
+	// The wall alignment is judged in the full judgement only (`in_full`):
+	// a screen never decides.
+	auto decisionScore = [&](const Similarity2D& t, size_t most, bool in_full, TwoWaySupport& sup, Chance& chance) {
+		sup = twoWaySupport(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most, in_full);
 		chance = chanceSupport(
 			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, options.verify_shift,
 			options.verify_turn_deg, most);
@@ -682,7 +682,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (!s.quick.transform.isFinite() || !(s.quick.transform.scale > 0) || !scaleAsStated(s.quick.transform))
 			return s;
 		clock.Tic();
-		s.score = decisionScore(s.quick.transform, size_t(options.screen_points), s.sup, s.chance);
+		s.score = decisionScore(s.quick.transform, size_t(options.screen_points), false, s.sup, s.chance);
 		s.verify_s = clock.Tac();
 		s.rmse_coarse = std::sqrt(s.quick.trimmed_mse) / std::max(1.0, s.quick.transform.scale);
 		MRPT_LOG_DEBUG_STREAM(
@@ -742,15 +742,15 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 													 : std::numeric_limits<double>::quiet_NaN();
 		TwoWaySupport sup;
 		Chance chance;
-		const double score = decisionScore(r.transform, kJudgedPoints, sup, chance);
+		const double score = decisionScore(r.transform, kJudgedPoints, true, sup, chance);
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
-		// A mirrored candidate is only ever a rival (its score counts, not its gates).
-		if (!mirror_pass)
-			cand.shift_coherence =
-				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance)
-					.coherence();
+		// Also for a mirrored candidate: one merged whatever comes (its gates
+		// passed) ends the mirror pass early.
+		cand.shift_coherence =
+			twoWayShiftField(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance)
+				.coherence();
 		// The first way to be sure (the maps coincide cell for cell) is this
 		// candidate's alone; the second is the pair's (decide, below). Both
 		// need walls enough to judge: a map squeezed into a few cells (TsICP

@@ -84,6 +84,12 @@ Support tolerantSupport(
  * counts, matter. A screen judges fewer. */
 constexpr size_t kJudgedPoints = 6000;
 
+/** hits over cases, pooled over both directions; 0 with no cases. */
+inline double pooledShare(size_t hits_a, size_t hits_b, size_t cases_a, size_t cases_b)
+{
+	return cases_a + cases_b ? double(hits_a + hits_b) / double(cases_a + cases_b) : 0.0;
+}
+
 /** Both ways, for a transform between two maps' cells. */
 struct TwoWaySupport
 {
@@ -95,8 +101,8 @@ struct TwoWaySupport
 	/** 1 − conflicts / judged over both directions. */
 	double consistency() const
 	{
-		const size_t j = other_in_ref.judged + ref_in_other.judged;
-		return j ? 1.0 - double(other_in_ref.conflicts + ref_in_other.conflicts) / double(j) : 0.0;
+		if (other_in_ref.judged + ref_in_other.judged == 0) return 0.0;
+		return 1.0 - pooledShare(other_in_ref.conflicts, ref_in_other.conflicts, other_in_ref.judged, ref_in_other.judged);
 	}
 	/** Wall alignment: of the supported points with a direction, over both
 	 * directions, the share near a wall of the other map running the same
@@ -104,8 +110,8 @@ struct TwoWaySupport
 	 * agreement, this does not. */
 	double wallAlignment() const
 	{
-		const size_t o = other_in_ref.directed + ref_in_other.directed;
-		return o ? double(other_in_ref.directed_supported + ref_in_other.directed_supported) / double(o) : 0.0;
+		return pooledShare(
+			other_in_ref.directed_supported, ref_in_other.directed_supported, other_in_ref.directed, ref_in_other.directed);
 	}
 };
 
@@ -151,8 +157,9 @@ struct TwoWayShiftField
 	 * agree within the tolerance; 0 with no adjacent tiles. */
 	double coherence() const
 	{
-		const size_t n = other_in_ref.neighbour_pairs + ref_in_other.neighbour_pairs;
-		return n ? double(other_in_ref.coherent_pairs + ref_in_other.coherent_pairs) / double(n) : 0.0;
+		return pooledShare(
+			other_in_ref.coherent_pairs, ref_in_other.coherent_pairs, other_in_ref.neighbour_pairs,
+			ref_in_other.neighbour_pairs);
 	}
 };
 TwoWayShiftField twoWayShiftField(
