@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Calibrates the aligner's decision on the calibration data only.
 
-Usage: /usr/bin/python3 scripts/calibrate_decision.py CANDIDATES.csv [MORE.csv ...]
+Usage: /usr/bin/python3 scripts/calibrate_decision.py [--all] CANDIDATES.csv [MORE.csv ...]
+
+Prints the best fits (the best for each runner-up weight, and the top
+TOP_FITS overall; --all: every combination tried), then the ini keys.
 
 The CSVs come from the benchmark (bench/multires_bench writes candidates.csv:
 every refined hypothesis of every pair, its features and whether it was right
@@ -108,6 +111,7 @@ LEADS = [0.0, 0.02, 0.04]
 ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.77, 0.78, 0.8]
 # decision_min_shift_coherence (0: no gate).
 COHERENCES = [0.0, 0.2, 0.25, 0.3]
+TOP_FITS = 20
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
 MIN_JUDGED = 40  # the aligner's kMinJudgedPoints
@@ -158,9 +162,11 @@ def distinct(a, b):
 
 
 def main():
-    if len(sys.argv) < 2:
+    show_all = "--all" in sys.argv[1:]
+    paths = [a for a in sys.argv[1:] if a != "--all"]
+    if not paths:
         sys.exit(__doc__)
-    rows = load(sys.argv[1:])
+    rows = load(paths)
     pairs = collections.defaultdict(list)
     for r in rows:
         pairs[r["pair"]].append(r)
@@ -177,6 +183,7 @@ def main():
           f"({len(reachable)} with a right candidate), {len(live)} live-fleet same-building pairs, "
           f"{len(pairs) - len(positives) - len(live)} negative pairs")
     best = None
+    fits = []  # (rank, runner-up weight, line) of every combination tried
     for w in WEIGHTS:
         for e in EVIDENCE:
             def score(r):
@@ -212,15 +219,27 @@ def main():
                                    if key in tops and tops[key]["right"] and values[key] >= threshold)
                 live_right = sum(1 for key in live
                                  if key in tops and tops[key]["right"] and values[key] >= threshold)
-                print(f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} lead {lead:4.2f} "
-                      f"alignment {align:4.2f} coherence {coh:4.2f}: "
-                      f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
-                      f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}")
                 rank = (merged_right, -k, w, e, floor, lead, align, coh)
+                fits.append((rank, k,
+                             f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} "
+                             f"lead {lead:4.2f} alignment {align:4.2f} coherence {coh:4.2f}: "
+                             f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
+                             f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}"))
                 if best is None or rank > best[0]:
                     per_file = collections.Counter(
                         key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
                     best = (rank, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file)
+    if show_all:
+        print("every fit tried:")
+        for _, _, line in fits:
+            print(line)
+    else:
+        print("the best fit for each runner-up weight:")
+        for weight in RUNNER_UP:
+            print(max((f for f in fits if f[1] == weight), key=lambda f: f[0])[2])
+        print(f"the {TOP_FITS} best fits (of {len(fits)}; --all prints every one):")
+        for _, _, line in sorted(fits, key=lambda f: f[0], reverse=True)[:TOP_FITS]:
+            print(line)
     _, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file = best
     print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
           f"decision_min_wall_alignment = {align}\ndecision_min_shift_coherence = {coh}\n"
@@ -229,7 +248,7 @@ def main():
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
           f"(margin {MARGIN} x (1 + runner-up weight) above the highest wrong value); live fleet pairs merged right "
           f"{live_right}/{len(live)}")
-    for path in sys.argv[1:]:
+    for path in paths:
         n = sum(1 for key in positives if key[3] == path)
         print(f"#   {path}: {per_file[path]}/{n} positive pairs merged right")
 

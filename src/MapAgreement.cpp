@@ -71,6 +71,25 @@ cv::Mat wallNormals(const cv::Mat& occupied)
 
 // Walls whose normals differ by at most this run the same way.
 constexpr double kSameDirectionDeg = 20.0;
+
+// How a point landing on target cell (x, y), inside the map, is judged:
+// near a wall counts even where the target has not seen the exact cell
+// (walls border unknown space); elsewhere only seen space judges, and a
+// point there farther than the tolerance from any wall or unknown cell is a
+// wall where the target clearly sees none.
+enum class Landing
+{
+	Unjudged,
+	Supported,
+	Agreeing,
+	Conflicting
+};
+Landing landing(const OccupancyField& target, int x, int y, double tolerance)
+{
+	if (target.dist_to_occupied.at<float>(y, x) <= tolerance) return Landing::Supported;
+	if (!target.known.at<uint8_t>(y, x)) return Landing::Unjudged;
+	return target.dist_to_not_free.at<float>(y, x) > tolerance ? Landing::Conflicting : Landing::Agreeing;
+}
 }  // namespace
 
 Agreement mapAgreement(
@@ -142,10 +161,8 @@ Support tolerantSupport(
 		const Eigen::Vector2d q = a * p + t.t;
 		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
 		if (x < 0 || y < 0 || x >= w || y >= h) continue;
-		// Near a wall counts even where the target has not seen the exact
-		// cell (walls border unknown space); elsewhere only seen space judges.
-		const float d = target.dist_to_occupied.at<float>(y, x);
-		if (d <= tolerance)
+		const Landing l = landing(target, x, y, tolerance);
+		if (l == Landing::Supported)
 		{
 			++s.judged, ++s.supported;
 			if (!directions) continue;
@@ -178,10 +195,10 @@ Support tolerantSupport(
 			++s.directed;
 			s.directed_supported += near_same;
 		}
-		else if (target.known.at<uint8_t>(y, x))
+		else if (l != Landing::Unjudged)
 		{
 			++s.judged;
-			s.conflicts += target.dist_to_not_free.at<float>(y, x) > tolerance;
+			s.conflicts += l == Landing::Conflicting;
 		}
 	}
 	return s;
@@ -253,21 +270,15 @@ ShiftField shiftField(
 				{
 					const int x = p.x + d.x, y = p.y + d.y;
 					if (x < 0 || y < 0 || x >= w || y >= h) continue;
-					if (target.dist_to_occupied.at<float>(y, x) <= tolerance)
-						++value, any = true;
-					else if (target.known.at<uint8_t>(y, x))
-					{
-						any = true;
-						value -= target.dist_to_not_free.at<float>(y, x) > tolerance;
-					}
+					const Landing l = landing(target, x, y, tolerance);
+					any = any || l != Landing::Unjudged;
+					value += l == Landing::Supported ? 1 : l == Landing::Conflicting ? -1 : 0;
 				}
 				const int norm = d.x * d.x + d.y * d.y;
 				if (any && (value > best_value || (value == best_value && norm < best_norm)))
 					best_value = value, best_norm = norm, best = d, judged = true;
 			}
-		if (!judged) continue;
-		++f.tiles;
-		best_shift[key] = best;
+		if (judged) best_shift[key] = best;
 	}
 	for (const auto& [key, d] : best_shift)
 		for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}})

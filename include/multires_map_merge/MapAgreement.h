@@ -128,8 +128,9 @@ TwoWaySupport twoWaySupport(
  * way. */
 struct ShiftField
 {
-	size_t tiles = 0;  //!< tiles with wall points enough to fit a shift
-	size_t neighbour_pairs = 0;  //!< adjacent (8-neighbour) pairs of those
+	/** Adjacent (8-neighbour) pairs of tiles with wall points enough to fit
+	 * a shift. */
+	size_t neighbour_pairs = 0;
 	size_t coherent_pairs = 0;  //!< of which shifted alike (within the tolerance)
 };
 
