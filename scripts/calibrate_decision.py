@@ -19,10 +19,13 @@ must not merge, and against the intel robot, negatives). F5 and KPT4A rows
 are the acceptance set and are never read here.
 
 The decision (src/CScalingGridMapAligner.cpp) scores each refined candidate by
-    score = T + chance_weight * (T - C) - sqrt(evidence / n)
+    score = B + chance_weight * (B - C) - sqrt(evidence / n)
 where T is the tolerant consistency (share of both maps' wall points moved
-onto seen space that do not land on clearly free space), C the best T under
-far perturbations of the transform (what chance gives in these maps), and n
+onto seen space that do not land on clearly free space), B the same with
+each tile of 30 coarse cells of the moved walls shifted as its neighbours
+fit best (the bent consistency: as if a smooth bend were taken out; the
+shifts below), C the best T under far perturbations of the transform (what
+chance gives in these maps), and n
 the number of wall points judged (the weaker direction): neighbouring wall
 points are far from independent, so a T measured on a small overlap (a map
 shrunk into a corner of the other) is discounted like a proportion from few
@@ -36,7 +39,7 @@ rivals nearly as good. The other map's mirror image is aligned too (the
 aligner's mirror_check; rows with mirrored=1): each of its candidates is a
 rival and never the best, so a map against its own mirror image, which fits
 itself mirrored exactly, is refused. The pair is merged when value >=
-threshold, and only if its best candidate's T leads C by the minimum lead
+threshold, and only if its best candidate's B leads C by the minimum lead
 and its wall alignment A (of the wall points near a wall of the other map
 that has a direction, the share near one running the same way, within
 about 20 degrees) reaches the minimum wall alignment: independent maps of
@@ -140,7 +143,8 @@ def load(paths):
                              and float(r["error"]) <= LIVE_NEAR_CELLS),
                     "screened": r.get("screened") == "1",
                     "mirrored": r.get("mirrored") == "1",
-                    "T": float(r["tolerant_consistency"]),
+                    # Absent from data written before it was measured: T there.
+                    "B": float(r.get("bent_consistency") or r["tolerant_consistency"]),
                     "C": float(r["chance_consistency"]),
                     # Absent from data written before it was measured: no gate there.
                     "A": float(r.get("wall_alignment") or "nan"),
@@ -187,7 +191,7 @@ def main():
     for w in WEIGHTS:
         for e in EVIDENCE:
             def score(r):
-                return r["T"] + w * (r["T"] - r["C"]) - math.sqrt(e / r["n"])
+                return r["B"] + w * (r["B"] - r["C"]) - math.sqrt(e / r["n"])
             scores = {id(r): score(r) for r in rows}
             tops = {}
             for key, c in pairs.items():
@@ -209,7 +213,7 @@ def main():
                 # than `coh`, cannot merge: below any threshold. Wrong tops
                 # within the gates' margins count as through them.
                 def through(top, lead_margin, align_margin, coh_margin):
-                    return (top["T"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
+                    return (top["B"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
                             and not top["H"] < coh - coh_margin)
                 values = {key: value(top) if through(top, 0, 0, 0) else -math.inf for key, top in tops.items()}
                 wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN, COHERENCE_MARGIN) else -math.inf

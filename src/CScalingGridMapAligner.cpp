@@ -188,9 +188,9 @@ bool CScalingGridMapAligner::areRivals(const TCandidate& a, const TCandidate& b)
 		std::log(1.1));
 }
 
-bool CScalingGridMapAligner::TConfigParams::leadsChance(double tolerant_consistency, double chance_consistency) const
+bool CScalingGridMapAligner::TConfigParams::leadsChance(double bent_consistency, double chance_consistency) const
 {
-	return tolerant_consistency - chance_consistency >= decision_min_lead;
+	return bent_consistency - chance_consistency >= decision_min_lead;
 }
 
 bool CScalingGridMapAligner::TConfigParams::wallsRunAlike(double wall_alignment) const
@@ -205,7 +205,7 @@ bool CScalingGridMapAligner::TConfigParams::shiftsCohere(double shift_coherence)
 
 bool CScalingGridMapAligner::mayMergeOnWalls(const TCandidate& c) const
 {
-	return options.leadsChance(c.tolerant_consistency, c.chance_consistency) &&
+	return options.leadsChance(c.bent_consistency, c.chance_consistency) &&
 		options.wallsRunAlike(c.wall_alignment) && options.shiftsCohere(c.shift_coherence);
 }
 
@@ -598,25 +598,38 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// taken for the count the decision would judge.
 	// The wall alignment is judged in the full judgement only (`in_full`):
 	// a screen never decides.
-	auto decisionScore = [&](const Similarity2D& t, size_t most, bool in_full, TwoWaySupport& sup, Chance& chance) {
-		sup = twoWaySupport(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most, in_full);
-		chance = chanceSupport(
+	struct Judgement
+	{
+		TwoWaySupport sup;
+		Chance chance;
+		TwoWayShiftField bends;
+		double score = 0;
+	};
+	auto decisionScore = [&](const Similarity2D& t, size_t most, bool in_full) {
+		Judgement j;
+		j.sup = twoWaySupport(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most, in_full);
+		j.chance = chanceSupport(
 			ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, options.verify_shift,
 			options.verify_turn_deg, most);
+		j.bends = twoWayShiftField(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance, most);
 		auto full = [&](size_t judged, size_t n) {
 			return double(judged) * double(std::min(n, kJudgedPoints)) / double(std::max<size_t>(1, std::min(n, most)));
 		};
 		const double judged = std::min(
-			full(sup.other_in_ref.judged, other_edges.size()), full(sup.ref_in_other.judged, ref_edges.size()));
-		const double tc = sup.consistency();
-		return tc + options.decision_chance_weight * (tc - chance.consistency) -
+			full(j.sup.other_in_ref.judged, other_edges.size()), full(j.sup.ref_in_other.judged, ref_edges.size()));
+		// Judged as if a smooth bend were taken out (TwoWayShiftField): two
+		// SLAM runs of one building differ by one.
+		const double bc = j.bends.bentConsistency();
+		j.score = bc + options.decision_chance_weight * (bc - j.chance.consistency) -
 			std::sqrt(options.decision_evidence / std::max(1.0, judged));
+		return j;
 	};
 	Eigen::Vector2d other_centroid(0, 0);
 	for (const auto& p : other_edges) other_centroid += p;
 	other_centroid /= double(other_edges.size());
 	auto candidate = [&other_centroid](const Hypothesis& h, const TsICPResult& r, double rmse_coarse, double cell_consistency,
-						const TwoWaySupport& sup, const Chance& chance, double score) {
+						const Judgement& j) {
+		const TwoWaySupport& sup = j.sup;
 		TCandidate c;
 		c.initial_cells = h.other_to_ref;
 		c.cells = r.transform;
@@ -624,12 +637,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.rmse_coarse_cells = rmse_coarse;
 		c.consistency = cell_consistency;
 		c.tolerant_consistency = sup.consistency();
-		c.chance_consistency = chance.consistency;
+		c.chance_consistency = j.chance.consistency;
 		c.support = sup.score();
-		c.chance_support = chance.support;
+		c.chance_support = j.chance.support;
 		c.wall_alignment = sup.wallAlignment();
+		c.bent_consistency = j.bends.bentConsistency();
+		c.shift_coherence = j.bends.coherence();
 		c.judged_points = sup.judged();
-		c.score = score;
+		c.score = j.score;
 		c.other_centre = r.transform.apply(other_centroid);
 		return c;
 	};
@@ -666,9 +681,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		bool ran = false;  //!< screen_points > 0
 		bool valid = false;  //!< a finite transform at the scale allowed
 		TsICPResult quick;
-		TwoWaySupport sup;
-		Chance chance;
-		double score = 0, rmse_coarse = 0;
+		Judgement judged;
+		double rmse_coarse = 0;
 		bool may_be_exact = false;
 		double icp_s = 0, verify_s = 0;
 	};
@@ -682,16 +696,17 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		if (!s.quick.transform.isFinite() || !(s.quick.transform.scale > 0) || !scaleAsStated(s.quick.transform))
 			return s;
 		clock.Tic();
-		s.score = decisionScore(s.quick.transform, size_t(options.screen_points), false, s.sup, s.chance);
+		s.judged = decisionScore(s.quick.transform, size_t(options.screen_points), false);
 		s.verify_s = clock.Tac();
 		s.rmse_coarse = std::sqrt(s.quick.trimmed_mse) / std::max(1.0, s.quick.transform.scale);
 		MRPT_LOG_DEBUG_STREAM(
 			"screen " << h.other_to_ref << " -> " << s.quick.transform << " rmse " << s.rmse_coarse
-					  << " tolerant consistency " << s.sup.consistency() << " chance " << s.chance.consistency
-					  << " score " << s.score);
+					  << " tolerant consistency " << s.judged.sup.consistency() << " bent "
+					  << s.judged.bends.bentConsistency() << " chance " << s.judged.chance.consistency << " score "
+					  << s.judged.score);
 		// Only where neither way to be sure (below) is near: the maps are
 		// not the same cells, and their walls agree too little.
-		s.may_be_exact = s.rmse_coarse < kExactMaxRmse && s.sup.consistency() > kExactMinScreenConsistency;
+		s.may_be_exact = s.rmse_coarse < kExactMaxRmse && s.judged.sup.consistency() > kExactMinScreenConsistency;
 		s.valid = true;
 		return s;
 	};
@@ -702,7 +717,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		return s.valid && !options.exhaustive_search && onExactFound(s.quick.transform);
 	};
 	auto stopsAtScreen = [&](const Screen& s) {
-		return s.ran && (!s.valid || (!s.may_be_exact && s.score < screen_bar) || convergedOnExact(s));
+		return s.ran && (!s.valid || (!s.may_be_exact && s.judged.score < screen_bar) || convergedOnExact(s));
 	};
 	// What a hypothesis that stops at its screen leaves: its screen's
 	// candidate (none without a valid screen).
@@ -710,7 +725,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		Refined out;
 		out.icp_s = s.icp_s, out.verify_s = s.verify_s;
 		if (!s.valid) return out;
-		out.cand = candidate(h, s.quick, s.rmse_coarse, std::numeric_limits<double>::quiet_NaN(), s.sup, s.chance, s.score);
+		out.cand = candidate(h, s.quick, s.rmse_coarse, std::numeric_limits<double>::quiet_NaN(), s.judged);
 		out.cand.screened = true;
 		out.cand.converged_on_exact = convergedOnExact(s);
 		out.r = s.quick;
@@ -740,17 +755,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		const bool may_be_exact = rmse_coarse < kExactMaxRmse;
 		const double cell_consistency = may_be_exact ? mapAgreement(ref_img, other_img, r.transform).consistency
 													 : std::numeric_limits<double>::quiet_NaN();
-		TwoWaySupport sup;
-		Chance chance;
-		const double score = decisionScore(r.transform, kJudgedPoints, true, sup, chance);
+		const Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
-		cand = candidate(h, r, rmse_coarse, cell_consistency, sup, chance, score);
-		// Also for a mirrored candidate: one merged whatever comes (its gates
-		// passed) ends the mirror pass early.
-		cand.shift_coherence =
-			twoWayShiftField(ref_edges, ref_field, other_edges, other_field, r.transform, options.verify_tolerance)
-				.coherence();
+		cand = candidate(h, r, rmse_coarse, cell_consistency, judgement);
 		// The first way to be sure (the maps coincide cell for cell) is this
 		// candidate's alone; the second is the pair's (decide, below). Both
 		// need walls enough to judge: a map squeezed into a few cells (TsICP
@@ -835,6 +843,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.chance_consistency = cand.chance_consistency;
 		info.wall_alignment = cand.wall_alignment;
 		info.shift_coherence = cand.shift_coherence;
+		info.bent_consistency = cand.bent_consistency;
 		info.score = cand.score;
 		info.runner_up_score = cand.runner_up_score;
 		info.decision_value = cand.decision_value;
@@ -911,7 +920,8 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 				MRPT_LOG_DEBUG_STREAM(
 					"hypothesis " << h.other_to_ref << " inliers " << h.inliers << " -> " << one.r.transform << " xi "
 								  << one.r.overlap << " rmse " << cand.rmse_coarse_cells << " tolerant consistency "
-								  << cand.tolerant_consistency << " chance " << cand.chance_consistency << " score "
+								  << cand.tolerant_consistency << " bent " << cand.bent_consistency << " chance "
+								  << cand.chance_consistency << " score "
 								  << cand.score
 								  << (cand.converged_on_exact ? " (on an exact candidate)" : cand.screened ? " (screened)" : "")
 								  << " exact conf "
@@ -1018,12 +1028,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	{
 		std::ostringstream why;
 		why << "alignment not confident enough (confidence " << info.confidence << " < "
-			<< options.min_confidence << "; tolerant consistency " << info.consistency << " against "
-			<< info.chance_consistency << " by chance";
+			<< options.min_confidence << "; tolerant consistency " << info.consistency << ", " << info.bent_consistency
+			<< " with its bends taken out, against " << info.chance_consistency << " by chance";
 		if (std::isfinite(info.decision_value))
 			why << ", score " << info.score << " against " << info.runner_up_score << " for the best rival (decision value "
 				<< info.decision_value << ", " << options.decision_threshold << " needed)";
-		if (std::isfinite(info.decision_value) && !options.leadsChance(info.consistency, info.chance_consistency))
+		if (std::isfinite(info.decision_value) && !options.leadsChance(info.bent_consistency, info.chance_consistency))
 			why << ", walls agreeing no more than chance (less than decision_min_lead = " << options.decision_min_lead
 				<< " above it)";
 		if (std::isfinite(info.decision_value) && !options.wallsRunAlike(info.wall_alignment))

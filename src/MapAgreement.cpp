@@ -235,19 +235,21 @@ TwoWaySupport twoWaySupport(
 }
 
 ShiftField shiftField(
-	const PointList& points, const Similarity2D& t, const OccupancyField& target, double tolerance, double tile,
+	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target, double tolerance, double tile,
 	double reach, double step)
 {
 	ShiftField f;
 	const int w = target.known.cols, h = target.known.rows;
 	const Eigen::Matrix2d a = t.linear();
 	std::map<std::pair<int, int>, std::vector<cv::Point>> tiles;
+	std::map<std::pair<int, int>, PointList> tile_sources;
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
 		if (!(q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach)) continue;
-		tiles[{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))}].emplace_back(
-			int(std::lround(q.x())), int(std::lround(q.y())));
+		const std::pair<int, int> key{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))};
+		tiles[key].emplace_back(int(std::lround(q.x())), int(std::lround(q.y())));
+		tile_sources[key].push_back(p);
 	}
 	// Fewer points than this fit some shift by chance: the tile says nothing.
 	constexpr size_t kMinTilePoints = 12;
@@ -280,6 +282,31 @@ ShiftField shiftField(
 			}
 		if (judged) best_shift[key] = best;
 	}
+	// Each tile judged again, shifted as its neighbours fit best (their
+	// component-wise median; none fitted: unshifted). A smooth bend is
+	// predicted by the neighbours and judged as if straightened; shifts that
+	// go each their own way (a wrong transform) predict nothing. Leaving the
+	// tile's own shift out keeps a tile from fitting itself onto any walls
+	// within reach, which chance does as well as the truth.
+	for (const auto& [key, pts] : tile_sources)
+	{
+		std::vector<int> xs, ys;
+		for (int dy = -1; dy <= 1; ++dy)
+			for (int dx = -1; dx <= 1; ++dx)
+			{
+				const auto it = best_shift.find({key.first + dx, key.second + dy});
+				if ((dx || dy) && it != best_shift.end()) xs.push_back(it->second.x), ys.push_back(it->second.y);
+			}
+		Similarity2D shifted = t;
+		if (!xs.empty())
+		{
+			std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
+			std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
+			shifted.t += Eigen::Vector2d(xs[xs.size() / 2], ys[ys.size() / 2]);
+		}
+		const Support s = tolerantSupport(pts, source, shifted, target, tolerance, false);
+		f.bent.judged += s.judged, f.bent.supported += s.supported, f.bent.conflicts += s.conflicts;
+	}
 	for (const auto& [key, d] : best_shift)
 		for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}})
 		{
@@ -298,13 +325,13 @@ TwoWayShiftField twoWayShiftField(
 	TwoWayShiftField f;
 	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return f;
 	// Tolerance, tile, reach and step in coarse cells, in each map's own cells.
-	for (const auto& [points, field, t, out] :
-		 {std::tuple{&other_points, &ref_field, other_to_ref, &f.other_in_ref},
-		  std::tuple{&ref_points, &other_field, other_to_ref.inverse(), &f.ref_in_other}})
+	for (const auto& [points, source, field, t, out] :
+		 {std::tuple{&other_points, &other_field, &ref_field, other_to_ref, &f.other_in_ref},
+		  std::tuple{&ref_points, &ref_field, &other_field, other_to_ref.inverse(), &f.ref_in_other}})
 	{
 		const double coarse = std::max(1.0, t.scale);  // target cells per coarse cell
 		*out = shiftField(
-			thinned(*points, most), t, *field, tol_coarse * coarse, kShiftTileCoarseCells * coarse,
+			thinned(*points, most), *source, t, *field, tol_coarse * coarse, kShiftTileCoarseCells * coarse,
 			kShiftReachCoarseCells * coarse, coarse);
 	}
 	return f;

@@ -354,7 +354,7 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	gated.options.decision_min_shift_coherence = ungated.options.decision_min_shift_coherence = 0;
 	const auto r = gated.alignScaled(ref, other), u = ungated.alignScaled(ref, other);
 	EXPECT_FALSE(r.success) << r.message;
-	EXPECT_LT(r.consistency - r.chance_consistency, gated.options.decision_min_lead);
+	EXPECT_LT(r.bent_consistency - r.chance_consistency, gated.options.decision_min_lead);
 	EXPECT_NE(r.message.find("no more than chance"), std::string::npos) << r.message;
 	// What the gate refuses: the same candidate, merged on its lead alone.
 	EXPECT_TRUE(u.success) << u.message;

@@ -111,7 +111,7 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		EXPECT_GT(rival, o.decision_runner_up_floor) << rivals << " rivals";
 		EXPECT_DOUBLE_EQ(best->runner_up_score, rival);
 		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision_runner_up_weight * (best->score - rival));
-		const bool walls_may_merge = o.leadsChance(best->tolerant_consistency, best->chance_consistency) &&
+		const bool walls_may_merge = o.leadsChance(best->bent_consistency, best->chance_consistency) &&
 			o.wallsRunAlike(best->wall_alignment) && o.shiftsCohere(best->shift_coherence);
 		EXPECT_EQ(walls_may_merge, aligner.mayMergeOnWalls(*best));
 		EXPECT_EQ(res.success, walls_may_merge && best->decision_value >= o.decision_threshold);
@@ -143,24 +143,25 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 {
 	REQUIRE_HALMSTAD();
 	// A reflection is no similarity: the same real map, flipped left-right.
-	const cv::Mat img = cv::imread(halmstad()->png("E5_01"), cv::IMREAD_GRAYSCALE);
+	const std::string map = "E5_04";
+	const cv::Mat img = cv::imread(halmstad()->png(map), cv::IMREAD_GRAYSCALE);
 	ASSERT_FALSE(img.empty());
 	cv::Mat flipped;
 	cv::flip(img, flipped, 1);
-	cv::imwrite(dir() + "/E5_01_mirrored.png", flipped);
-	std::ofstream(dir() + "/E5_01_mirrored.yaml")
-		<< "image: E5_01_mirrored.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+	cv::imwrite(dir() + "/" + map + "_mirrored.png", flipped);
+	std::ofstream(dir() + "/" + map + "_mirrored.yaml")
+		<< "image: " << map << "_mirrored.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
 		   "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
-	const GridInFrame mirrored = loadGridMap(dir() + "/E5_01_mirrored.yaml");
+	const GridInFrame mirrored = loadGridMap(dir() + "/" + map + "_mirrored.yaml");
 	const auto res = CScalingGridMapAligner().alignScaled(loadGridMap(halmstad()->yaml("E5_02", dir())), mirrored);
 	EXPECT_FALSE(res.success) << "confidence " << res.confidence;
 
 	// Against its own mirror image the map's symmetries fit well enough to
-	// merge on the walls' consistency alone (without the wall-alignment
-	// gate, which by itself refuses this pair only just: its near walls run
-	// alike about as often as the gate's bar); the mirror check sees that
-	// the map fits itself better mirrored, refuses, and says why.
-	const GridInFrame original = loadGridMap(halmstad()->yaml("E5_01", dir()));
+	// merge on the walls alone (without the wall-alignment gate, which by
+	// itself refuses this pair: its near walls run alike about as often as
+	// the gate's bar); the mirror check sees that the map fits itself
+	// better mirrored, refuses, and says why.
+	const GridInFrame original = loadGridMap(halmstad()->yaml(map, dir()));
 	CScalingGridMapAligner unchecked, checked;
 	unchecked.options.decision_min_wall_alignment = checked.options.decision_min_wall_alignment = 0;
 	unchecked.options.mirror_check = false;
@@ -200,7 +201,7 @@ TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
 			EXPECT_LE((a.metric(corner) - b.metric(corner)).norm(), 0.05) << corner.transpose();
 	}
 	{
-		const GridInFrame r = load("E5_03"), o = load("E5_01");
+		const GridInFrame r = load("E5_09"), o = load("E5_06");
 		const auto a = screened.alignScaled(r, o), b = full.alignScaled(r, o);
 		EXPECT_FALSE(a.success);
 		EXPECT_FALSE(b.success);

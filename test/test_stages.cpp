@@ -277,6 +277,44 @@ TEST(MapAgreement, RegionsShiftAlikeUnderTheTruthNotWhenTurned)
 	EXPECT_LT(coherence(Similarity2D(1, 0, {60, 0}).compose(m.truth)), at_truth.coherence() - 0.3);
 }
 
+TEST(MapAgreement, TakingOutASmoothBendRestoresTheWallsUnderTheTruthOnly)
+{
+	// Bent by a wave of up to 7 cells, beyond the tolerance (3): under the
+	// truth many walls miss the other map's, yet each region's neighbours
+	// predict the shift that puts it back (the bent consistency). A wrong
+	// transform's regions fit by shifts of their own, which predict nothing.
+	const MalagaSupport m;
+	cv::Mat map_x(m.b.size(), CV_32F), map_y(m.b.size(), CV_32F);
+	for (int y = 0; y < m.b.rows; ++y)
+		for (int x = 0; x < m.b.cols; ++x)
+		{
+			map_x.at<float>(y, x) = float(x + 7.0 * std::sin(2 * M_PI * y / m.b.rows));
+			map_y.at<float>(y, x) = float(y + 7.0 * std::sin(2 * M_PI * x / m.b.cols));
+		}
+	cv::Mat bent;
+	cv::remap(m.b, bent, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(kUnknown));
+	const PointList bent_edges = edgePoints(bent);
+	const OccupancyField bent_field = occupancyField(bent);
+	auto rigid = [&](const Similarity2D& t) {
+		return twoWaySupport(m.ea, m.fa, bent_edges, bent_field, t, 3.0).consistency();
+	};
+	auto unbent = [&](const Similarity2D& t) {
+		return twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, t, 3.0).bentConsistency();
+	};
+	const double truth_rigid = rigid(m.truth), truth_unbent = unbent(m.truth);
+	EXPECT_LT(truth_rigid, 0.65) << "the bend moves many walls beyond the tolerance";
+	EXPECT_GT(truth_unbent, 0.85);
+	EXPECT_GT(truth_unbent, truth_rigid + 0.25);
+	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
+	Similarity2D turn(1, M_PI / 4, {0, 0});
+	turn.t = centre - turn.apply(centre);
+	const Similarity2D turned = turn.compose(m.truth), slid = Similarity2D(1, 0, {60, 0}).compose(m.truth);
+	EXPECT_LT(unbent(turned), rigid(turned) + 0.05) << "turned: nothing to take out";
+	EXPECT_LT(unbent(turned), truth_unbent - 0.4);
+	// Slid 30 coarse cells along corridors, some regions fit alike.
+	EXPECT_LT(unbent(slid), truth_unbent - 0.35);
+}
+
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 {
 	// The same real map at 5 and 8 cm (rendered from the scans), the coarse

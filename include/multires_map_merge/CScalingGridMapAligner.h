@@ -110,9 +110,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 200;
+		double decision_evidence = 400;
 		/** The best candidate merges on its walls only if they agree more
-		 * than chance by at least this (tolerant consistency − chance): two
+		 * than chance by at least this (bent consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
 		 * against a large one of another building) prove nothing, however
 		 * few rivals they have. */
@@ -122,7 +122,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * map lie near one running the same way (within 20°;
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.80;
+		double decision_min_wall_alignment = 0.76;
 		/** The best candidate merges on its walls only if at least this
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
@@ -136,14 +136,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double decision_runner_up_weight = 1.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
-		double decision_runner_up_floor = 0.25;
+		double decision_runner_up_floor = 0.0;
 		/** Candidates whose other-map wall centroids lie more than this many
 		 * coarse cells apart (or turned by over verify_turn_deg, or scaled by
 		 * over 10 %) are rivals, not one answer. */
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.464;
+		double decision_threshold = 0.498;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -173,9 +173,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double relevantScore(double best_score) const;
 		/** Decision value per unit of confidence: 0.2 (1 + runner-up weight). */
 		double valuePerConfidence() const;
-		/** Walls agreeing this well (tolerant consistency) against chance
+		/** Walls agreeing this well (bent consistency) against chance
 		 * may merge on them: they lead chance by decision_min_lead. */
-		bool leadsChance(double tolerant_consistency, double chance_consistency) const;
+		bool leadsChance(double bent_consistency, double chance_consistency) const;
 		/** Walls near each other run alike in at least
 		 * decision_min_wall_alignment of the cases. */
 		bool wallsRunAlike(double wall_alignment) const;
@@ -206,10 +206,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * one running the same way (TwoWaySupport::wallAlignment). */
 		double wall_alignment = 0;
 		/** Of adjacent tiles of the moved walls, the share whose best small
-		 * shifts agree (TwoWayShiftField::coherence; full judgement only). */
+		 * shifts agree (TwoWayShiftField::coherence). */
 		double shift_coherence = 0;
+		/** The tolerant consistency with each tile of the moved walls shifted
+		 * as its neighbours fit best (TwoWayShiftField::bentConsistency): as
+		 * if a smooth bend were taken out. */
+		double bent_consistency = 0;
 		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
-		/** tolerant_consistency + chance_weight · (it − chance) − √(evidence / judged) */
+		/** bent_consistency + chance_weight · (it − chance) − √(evidence / judged) */
 		double score = 0;
 		/** From the cells alone (the maps coincide cell for cell); 0 when they cannot. */
 		double exact_confidence = 0;
@@ -262,6 +266,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double consistency = 0, chance_consistency = 0;
 		double wall_alignment = 0;  //!< TCandidate::wall_alignment of the chosen candidate
 		double shift_coherence = 0;  //!< TCandidate::shift_coherence of the chosen candidate
+		double bent_consistency = 0;  //!< TCandidate::bent_consistency of the chosen candidate
 		/** The chosen candidate's score, and where it is the pair's best-
 		 * scoring one, its best distinct rival's score and the decision value
 		 * (TCandidate; NaN otherwise). */

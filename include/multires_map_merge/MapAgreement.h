@@ -90,6 +90,12 @@ inline double pooledShare(size_t hits_a, size_t hits_b, size_t cases_a, size_t c
 	return cases_a + cases_b ? double(hits_a + hits_b) / double(cases_a + cases_b) : 0.0;
 }
 
+/** 1 − conflicts / judged, pooled over both directions; 0 with nothing judged. */
+inline double pooledConsistency(const Support& a, const Support& b)
+{
+	return a.judged + b.judged ? 1.0 - pooledShare(a.conflicts, b.conflicts, a.judged, b.judged) : 0.0;
+}
+
 /** Both ways, for a transform between two maps' cells. */
 struct TwoWaySupport
 {
@@ -99,11 +105,7 @@ struct TwoWaySupport
 	double score() const { return std::min(other_in_ref.ratio(), ref_in_other.ratio()); }
 	size_t judged() const { return std::min(other_in_ref.judged, ref_in_other.judged); }
 	/** 1 − conflicts / judged over both directions. */
-	double consistency() const
-	{
-		if (other_in_ref.judged + ref_in_other.judged == 0) return 0.0;
-		return 1.0 - pooledShare(other_in_ref.conflicts, ref_in_other.conflicts, other_in_ref.judged, ref_in_other.judged);
-	}
+	double consistency() const { return pooledConsistency(other_in_ref, ref_in_other); }
 	/** Wall alignment: of the supported points with a direction, over both
 	 * directions, the share near a wall of the other map running the same
 	 * way. A wrong transform lays walls across walls; T counts that as
@@ -132,15 +134,20 @@ struct ShiftField
 	 * a shift. */
 	size_t neighbour_pairs = 0;
 	size_t coherent_pairs = 0;  //!< of which shifted alike (within the tolerance)
+	/** Every tile's points judged (tolerantSupport, without directions)
+	 * after the shift its neighbours fit best: the walls as if a smooth bend
+	 * were taken out. */
+	Support bent;
 };
 
-/** `points` (source cells) moved by `source_to_target` into the target,
- * binned in square tiles of `tile` target cells; each tile's best shift
- * (within ±`reach`, by `step`) is the one that puts the most points within
- * `tolerance` of a target wall less those on the target's clearly free
- * space (tolerantSupport's counts); ties go to the smaller shift. */
+/** `points` (cells of the `source` map) moved by `source_to_target` into
+ * the target, binned in square tiles of `tile` target cells; each tile's
+ * best shift (within ±`reach`, by `step`) is the one that puts the most
+ * points within `tolerance` of a target wall less those on the target's
+ * clearly free space (tolerantSupport's counts); ties go to the smaller
+ * shift. */
 ShiftField shiftField(
-	const PointList& points, const Similarity2D& source_to_target, const OccupancyField& target, double tolerance,
+	const PointList& points, const OccupancyField& source, const Similarity2D& source_to_target, const OccupancyField& target, double tolerance,
 	double tile, double reach, double step);
 
 /** Tiles of this many coarse cells, shifts within this reach: the bending of
@@ -162,6 +169,9 @@ struct TwoWayShiftField
 			other_in_ref.coherent_pairs, ref_in_other.coherent_pairs, other_in_ref.neighbour_pairs,
 			ref_in_other.neighbour_pairs);
 	}
+	/** The tolerant consistency (TwoWaySupport::consistency) with each tile
+	 * shifted as its neighbours fit best, over both directions. */
+	double bentConsistency() const { return pooledConsistency(other_in_ref.bent, ref_in_other.bent); }
 };
 TwoWayShiftField twoWayShiftField(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
