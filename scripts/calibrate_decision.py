@@ -53,7 +53,12 @@ walls fits each region by a shift of its own.
 
 This script picks chance_weight, evidence, runner_up_weight, floor, the
 minimum lead, the minimum wall alignment and the minimum shift coherence
-(the most right merges; ties go to the smaller runner-up weight, then the
+(the most right merges; ties go to the fit that asks most of a candidate
+with no rival, i.e. the highest lowest mergeable score
+(threshold + runner_up_weight * floor) / (1 + runner_up_weight), to three
+decimals: a best candidate alone, as on a small overlap or a map of a new
+building, is what the calibration data checks least, and the screen drops
+more below a higher bar; then to the smaller runner-up weight, then the
 larger chance weight, evidence, floor, minimum lead, wall alignment and
 shift coherence: the safer where it costs nothing; a coherence gate must
 stay COHERENCE_MARGIN below every right best candidate's) and sets
@@ -223,7 +228,8 @@ def main():
                                    if key in tops and tops[key]["right"] and values[key] >= threshold)
                 live_right = sum(1 for key in live
                                  if key in tops and tops[key]["right"] and values[key] >= threshold)
-                rank = (merged_right, -k, w, e, floor, lead, align, coh)
+                lowest_mergeable = round((threshold + k * floor) / (1 + k), 3)
+                rank = (merged_right, lowest_mergeable, -k, w, e, floor, lead, align, coh)
                 fits.append((rank, k,
                              f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} "
                              f"lead {lead:4.2f} alignment {align:4.2f} coherence {coh:4.2f}: "

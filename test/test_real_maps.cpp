@@ -193,12 +193,22 @@ TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
 		ASSERT_TRUE(a.success) << a.message;
 		ASSERT_TRUE(b.success) << b.message;
 		// A kept hypothesis is refined on every point from the sample's
-		// result: the same optimum to within a cell (5 cm; independent maps'
-		// optimum is that flat: 0.8 cells apart with the refit decision).
+		// result, which lands elsewhere in the optimum than from the
+		// hypothesis; independent maps' optimum is flat, and flatter judged
+		// with the bends taken out (the bent consistency): refinements a few
+		// cells apart score alike, and which of them is chosen varies (11
+		// cells apart at the map's corners with and without the screen).
+		// The same placement, then (no rivals: within distinct_shift), and
+		// both right against the annotation.
 		EXPECT_NEAR(a.confidence, b.confidence, 0.05);
 		const double w = o.grid.getXMax() - o.grid.getXMin(), h = o.grid.getYMax() - o.grid.getYMin();
+		const double same_placement_m = screened.options.distinct_shift * r.grid.getResolution();
 		for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
-			EXPECT_LE((a.metric(corner) - b.metric(corner)).norm(), 0.05) << corner.transpose();
+			EXPECT_LE((a.metric(corner) - b.metric(corner)).norm(), same_placement_m) << corner.transpose();
+		const auto* truth = halmstad()->pair("E5_01", "E5_02");
+		ASSERT_NE(truth, nullptr);
+		for (const auto* res : {&a, &b})
+			EXPECT_LE(multires_bench::judge(res->metric, *truth, o, int(r.grid.getSizeY())).mean_displacement_px, 40);
 	}
 	{
 		const GridInFrame r = load("E5_09"), o = load("E5_06");

@@ -110,7 +110,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 400;
+		double decision_evidence = 200;
 		/** The best candidate merges on its walls only if they agree more
 		 * than chance by at least this (bent consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
@@ -122,7 +122,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * map lie near one running the same way (within 20°;
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.76;
+		double decision_min_wall_alignment = 0.77;
 		/** The best candidate merges on its walls only if at least this
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
@@ -133,17 +133,17 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 1.0;
+		double decision_runner_up_weight = 3.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
-		double decision_runner_up_floor = 0.0;
+		double decision_runner_up_floor = 0.25;
 		/** Candidates whose other-map wall centroids lie more than this many
 		 * coarse cells apart (or turned by over verify_turn_deg, or scaled by
 		 * over 10 %) are rivals, not one answer. */
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.498;
+		double decision_threshold = 0.825;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
