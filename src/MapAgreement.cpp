@@ -258,6 +258,17 @@ ShiftField shiftField(
 	for (const auto& [key, pts] : tiles)
 	{
 		if (pts.size() < kMinTilePoints) continue;
+		// How a point lands anywhere in the tile's window (its points' box
+		// grown by the reach), judged once: every shift reads it.
+		const int r = int(std::lround(steps * step));
+		int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
+		for (const auto& p : pts) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+		x0 -= r, y0 -= r, x1 += r, y1 += r;
+		const int window_w = x1 - x0 + 1;
+		std::vector<Landing> window(size_t(window_w) * size_t(y1 - y0 + 1), Landing::Unjudged);
+		for (int y = std::max(0, y0); y <= std::min(h - 1, y1); ++y)
+			for (int x = std::max(0, x0); x <= std::min(w - 1, x1); ++x)
+				window[size_t(y - y0) * window_w + size_t(x - x0)] = landing(target, x, y, tolerance);
 		long best_value = std::numeric_limits<long>::min();
 		int best_norm = 0;
 		bool judged = false;
@@ -270,9 +281,7 @@ ShiftField shiftField(
 				bool any = false;
 				for (const auto& p : pts)
 				{
-					const int x = p.x + d.x, y = p.y + d.y;
-					if (x < 0 || y < 0 || x >= w || y >= h) continue;
-					const Landing l = landing(target, x, y, tolerance);
+					const Landing l = window[size_t(p.y + d.y - y0) * window_w + size_t(p.x + d.x - x0)];
 					any = any || l != Landing::Unjudged;
 					value += l == Landing::Supported ? 1 : l == Landing::Conflicting ? -1 : 0;
 				}
