@@ -243,76 +243,80 @@ TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 100u) << "turned walls still lie near walls";
 }
 
+namespace
+{
+/** The malaga pair with the other map bent smoothly, as SLAM bends walls:
+ * each cell moved by a sine wave of up to `amplitude` cells across the map;
+ * judged (tolerance 3 cells) under the truth or wrong transforms. */
+struct BentMalaga : MalagaSupport
+{
+	PointList bent_edges;
+	OccupancyField bent_field;
+	explicit BentMalaga(double amplitude)
+	{
+		cv::Mat map_x(b.size(), CV_32F), map_y(b.size(), CV_32F);
+		for (int y = 0; y < b.rows; ++y)
+			for (int x = 0; x < b.cols; ++x)
+			{
+				map_x.at<float>(y, x) = float(x + amplitude * std::sin(2 * M_PI * y / b.rows));
+				map_y.at<float>(y, x) = float(y + amplitude * std::sin(2 * M_PI * x / b.cols));
+			}
+		cv::Mat bent;
+		cv::remap(b, bent, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(kUnknown));
+		bent_edges = edgePoints(bent);
+		bent_field = occupancyField(bent);
+	}
+	TwoWayShiftField shifts(const Similarity2D& t) const
+	{
+		return twoWayShiftField(ea, fa, bent_edges, bent_field, t, 3.0);
+	}
+	double rigidConsistency(const Similarity2D& t) const
+	{
+		return twoWaySupport(ea, fa, bent_edges, bent_field, t, 3.0).consistency();
+	}
+	/** Turned by 45° about the map's centre: walls still lie near walls
+	 * here and there. */
+	Similarity2D turned() const
+	{
+		const Eigen::Vector2d centre(a.cols / 2.0, a.rows / 2.0);
+		Similarity2D turn(1, M_PI / 4, {0, 0});
+		turn.t = centre - turn.apply(centre);
+		return turn.compose(truth);
+	}
+	/** Slid 30 coarse cells: along corridors, some regions still fit. */
+	Similarity2D slid() const { return Similarity2D(1, 0, {60, 0}).compose(truth); }
+};
+}  // namespace
+
 TEST(MapAgreement, RegionsShiftAlikeUnderTheTruthNotWhenTurned)
 {
-	// The other map bent smoothly (a wave of up to 4 of its cells across the
-	// map, as SLAM bends walls): under the truth its regions fit best after
-	// shifts that vary smoothly. Turned by 45° about the map's centre, walls
-	// still lie near walls here and there, each region by a shift of its own.
-	const MalagaSupport m;
-	cv::Mat map_x(m.b.size(), CV_32F), map_y(m.b.size(), CV_32F);
-	for (int y = 0; y < m.b.rows; ++y)
-		for (int x = 0; x < m.b.cols; ++x)
-		{
-			map_x.at<float>(y, x) = float(x + 4.0 * std::sin(2 * M_PI * y / m.b.rows));
-			map_y.at<float>(y, x) = float(y + 4.0 * std::sin(2 * M_PI * x / m.b.cols));
-		}
-	cv::Mat bent;
-	cv::remap(m.b, bent, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(kUnknown));
-	const PointList bent_edges = edgePoints(bent);
-	const OccupancyField bent_field = occupancyField(bent);
-	auto coherence = [&](const Similarity2D& t) {
-		return twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, t, 3.0).coherence();
-	};
-	const TwoWayShiftField at_truth = twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, m.truth, 3.0);
+	// Bent by up to 4 cells: under the truth its regions fit best after
+	// shifts that vary smoothly; turned or slid, each region by a shift of
+	// its own.
+	const BentMalaga m(4.0);
+	const TwoWayShiftField at_truth = m.shifts(m.truth);
 	EXPECT_GT(at_truth.coherence(), 0.6);
 	EXPECT_GT(at_truth.other_in_ref.neighbour_pairs + at_truth.ref_in_other.neighbour_pairs, 20u);
-	EXPECT_GT(twoWaySupport(m.ea, m.fa, bent_edges, bent_field, m.truth, 3.0).consistency(), 0.7)
-		<< "bent, yet the walls still lie near each other";
-	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
-	Similarity2D turn(1, M_PI / 4, {0, 0});
-	turn.t = centre - turn.apply(centre);
-	EXPECT_LT(coherence(turn.compose(m.truth)), 0.3);
-	// Slid 30 coarse cells (along corridors, some regions still fit alike).
-	EXPECT_LT(coherence(Similarity2D(1, 0, {60, 0}).compose(m.truth)), at_truth.coherence() - 0.3);
+	EXPECT_GT(m.rigidConsistency(m.truth), 0.7) << "bent, yet the walls still lie near each other";
+	EXPECT_LT(m.shifts(m.turned()).coherence(), 0.3);
+	EXPECT_LT(m.shifts(m.slid()).coherence(), at_truth.coherence() - 0.3);
 }
 
 TEST(MapAgreement, TakingOutASmoothBendRestoresTheWallsUnderTheTruthOnly)
 {
-	// Bent by a wave of up to 7 cells, beyond the tolerance (3): under the
-	// truth many walls miss the other map's, yet each region's neighbours
-	// predict the shift that puts it back (the bent consistency). A wrong
-	// transform's regions fit by shifts of their own, which predict nothing.
-	const MalagaSupport m;
-	cv::Mat map_x(m.b.size(), CV_32F), map_y(m.b.size(), CV_32F);
-	for (int y = 0; y < m.b.rows; ++y)
-		for (int x = 0; x < m.b.cols; ++x)
-		{
-			map_x.at<float>(y, x) = float(x + 7.0 * std::sin(2 * M_PI * y / m.b.rows));
-			map_y.at<float>(y, x) = float(y + 7.0 * std::sin(2 * M_PI * x / m.b.cols));
-		}
-	cv::Mat bent;
-	cv::remap(m.b, bent, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar(kUnknown));
-	const PointList bent_edges = edgePoints(bent);
-	const OccupancyField bent_field = occupancyField(bent);
-	auto rigid = [&](const Similarity2D& t) {
-		return twoWaySupport(m.ea, m.fa, bent_edges, bent_field, t, 3.0).consistency();
-	};
-	auto unbent = [&](const Similarity2D& t) {
-		return twoWayShiftField(m.ea, m.fa, bent_edges, bent_field, t, 3.0).bentConsistency();
-	};
-	const double truth_rigid = rigid(m.truth), truth_unbent = unbent(m.truth);
+	// Bent by up to 7 cells, beyond the tolerance (3): under the truth many
+	// walls miss the other map's, yet each region's neighbours predict the
+	// shift that puts it back (the bent consistency). A wrong transform's
+	// regions fit by shifts of their own, which predict nothing.
+	const BentMalaga m(7.0);
+	const double truth_rigid = m.rigidConsistency(m.truth), truth_unbent = m.shifts(m.truth).bentConsistency();
 	EXPECT_LT(truth_rigid, 0.65) << "the bend moves many walls beyond the tolerance";
 	EXPECT_GT(truth_unbent, 0.85);
 	EXPECT_GT(truth_unbent, truth_rigid + 0.25);
-	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
-	Similarity2D turn(1, M_PI / 4, {0, 0});
-	turn.t = centre - turn.apply(centre);
-	const Similarity2D turned = turn.compose(m.truth), slid = Similarity2D(1, 0, {60, 0}).compose(m.truth);
-	EXPECT_LT(unbent(turned), rigid(turned) + 0.05) << "turned: nothing to take out";
-	EXPECT_LT(unbent(turned), truth_unbent - 0.4);
-	// Slid 30 coarse cells along corridors, some regions fit alike.
-	EXPECT_LT(unbent(slid), truth_unbent - 0.35);
+	const double turned = m.shifts(m.turned()).bentConsistency();
+	EXPECT_LT(turned, m.rigidConsistency(m.turned()) + 0.05) << "turned: nothing to take out";
+	EXPECT_LT(turned, truth_unbent - 0.4);
+	EXPECT_LT(m.shifts(m.slid()).bentConsistency(), truth_unbent - 0.35);
 }
 
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
