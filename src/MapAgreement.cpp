@@ -235,8 +235,8 @@ TwoWaySupport twoWaySupport(
 }
 
 ShiftField shiftField(
-	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target, double tolerance, double tile,
-	double reach, double step)
+	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target,
+	double tolerance, double tile, double reach, double step)
 {
 	ShiftField f;
 	const int w = target.known.cols, h = target.known.rows;
@@ -262,7 +262,8 @@ ShiftField shiftField(
 		// grown by the reach), judged once: every shift reads it.
 		const int r = int(std::lround(steps * step));
 		int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(), y1 = x1;
-		for (const auto& p : pts) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+		for (const auto& p : pts)
+			x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
 		x0 -= r, y0 -= r, x1 += r, y1 += r;
 		const int window_w = x1 - x0 + 1;
 		std::vector<Landing> window(size_t(window_w) * size_t(y1 - y0 + 1), Landing::Unjudged);

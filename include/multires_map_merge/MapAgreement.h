@@ -147,8 +147,8 @@ struct ShiftField
  * clearly free space (tolerantSupport's counts); ties go to the smaller
  * shift. */
 ShiftField shiftField(
-	const PointList& points, const OccupancyField& source, const Similarity2D& source_to_target, const OccupancyField& target, double tolerance,
-	double tile, double reach, double step);
+	const PointList& points, const OccupancyField& source, const Similarity2D& source_to_target,
+	const OccupancyField& target, double tolerance, double tile, double reach, double step);
 
 /** Tiles of this many coarse cells, shifts within this reach: the bending of
  * independent maps (a few cells over a room) without letting a tile slide
