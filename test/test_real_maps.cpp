@@ -123,9 +123,13 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		{
 			EXPECT_NE(res.message.find("best rival"), std::string::npos) << res.message;
 			if (!o.wallsRunAlike(best->wall_alignment))
+			{
 				EXPECT_NE(res.message.find("running alike"), std::string::npos) << res.message;
+			}
 			if (!o.shiftsCohere(best->shift_coherence))
+			{
 				EXPECT_NE(res.message.find("shifts alike"), std::string::npos) << res.message;
+			}
 		}
 	}
 }
