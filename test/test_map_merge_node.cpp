@@ -138,12 +138,17 @@ TEST(MapMergeNode, MergesAFleetFromABagAndSurvivesGarbage)
 	{
 		std::lock_guard<std::mutex> l(w.m);
 		ASSERT_TRUE(w.status) << "no status from map_merge";
+		// (A SCOPED_TRACE in a loop body ends with the body: the status goes
+		// into the message instead.)
+		std::string statuses;
 		for (size_t i = 0; i < w.status->robots.size(); ++i)
-			SCOPED_TRACE(w.status->robots[i] + ": " + w.status->messages[i]);
-		ASSERT_TRUE(settled) << "robots not placed as expected within 300 s";
+			statuses += "\n" + w.status->robots[i] + ": " + w.status->messages[i];
+		ASSERT_TRUE(settled) << "robots not placed as expected within 300 s" << statuses;
 		for (size_t i = 0; i < w.status->robots.size(); ++i)
 			if (w.status->robots[i] == "/robot4")
+			{
 				EXPECT_NE(w.status->messages[i].find("not placed"), std::string::npos) << w.status->messages[i];
+			}
 	}
 	// TF against the truth. The world is one robot's map frame (whichever
 	// the node settled on), so robot 1's frame in it is the truth's origin:
