@@ -105,8 +105,16 @@ TEST(MergeMapsLoad, ThousandMixedRequestsFourClientsAtOnce)
 	EXPECT_TRUE(ros::service::exists("/merge_maps", false)) << "the node is gone";
 	const double end_rss = rssMb(pid);
 	ASSERT_GT(warm_rss, 0);
+#if defined(__SANITIZE_ADDRESS__)
+	// ASan's allocator keeps freed memory in quarantine (up to 256 MB), so
+	// the node's resident memory grows with how much it allocates, not with
+	// what it keeps: the bound is checked in the un-instrumented suite
+	// (scripts/test.sh runs both); here the requests run for memory errors.
+	(void)end_rss;
+#else
 	EXPECT_LE(end_rss, warm_rss + kRssGrowthBoundMb)
 		<< "resident memory grew from " << warm_rss << " MB to " << end_rss << " MB";
+#endif
 	std::cout << "node RSS: " << warm_rss << " MB after 100 requests, " << end_rss << " MB after " << kRequests
 			  << std::endl;
 }
