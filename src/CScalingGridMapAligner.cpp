@@ -52,6 +52,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(icp_coarse_points, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(screen_points, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(screen_margin, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(bend_refit_iterations, int, c, s);
 	MRPT_LOAD_CONFIG_VAR(icp_finish_on_occupied, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_max_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_lattice_step, double, c, s);
@@ -100,6 +101,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	if (screen_points != 0)  // 0 turns it off; a screen needs enough points to judge
 		in("screen_points", screen_points, 100, 1e9);
 	in("screen_margin", screen_margin, 0, 10);
+	in("bend_refit_iterations", bend_refit_iterations, 0, 100);
 	in("finish_max_shift", finish_max_shift, 0, 100);
 	if (finish_lattice_step != 0)  // 0 turns it off; finer steps only cost time
 		in("finish_lattice_step", finish_lattice_step, 0.01, 0.5);
@@ -144,6 +146,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_coarse_points, "TsICP converges on about this many points first (0: all)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_points, "Each hypothesis is first refined and judged on about this many points (0: off)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(screen_margin, "Dropped there when its score is this far below the lowest score that can merge");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(bend_refit_iterations, "Refits of the transform to its wall tiles' best shifts (0: off)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_lattice_step, "Step of the finish's sub-cell shift on the coarser lattice (0: off) [coarse cells]");
@@ -742,7 +745,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		// cell short of exact.
 		const Similarity2D full_start = s.ran && !s.may_be_exact ? s.quick.transform : h.other_to_ref;
 		mrpt::system::CTicTac clock;
-		const TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
+		TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
 		out.icp_s += clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0) || !scaleAsStated(r.transform)) return out;
 
@@ -755,7 +758,24 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		const bool may_be_exact = rmse_coarse < kExactMaxRmse;
 		const double cell_consistency = may_be_exact ? mapAgreement(ref_img, other_img, r.transform).consistency
 													 : std::numeric_limits<double>::quiet_NaN();
-		const Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
+		Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
+		// Not where the maps may be the same cells: TsICP is exact there.
+		if (options.bend_refit_iterations > 0 && !may_be_exact)
+		{
+			Similarity2D balanced = r.transform;
+			TwoWayShiftField bends = judgement.bends;
+			for (int i = 0; i < options.bend_refit_iterations; ++i)
+			{
+				balanced = bendBalanced(bends, balanced);
+				if (!balanced.isFinite() || !(balanced.scale > 0) || !scaleAsStated(balanced)) break;
+				if (i + 1 < options.bend_refit_iterations)
+					bends = twoWayShiftField(
+						ref_edges, ref_field, other_edges, other_field, balanced, options.verify_tolerance);
+			}
+			if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced))
+				if (Judgement j = decisionScore(balanced, kJudgedPoints, true); j.score > judgement.score)
+					judgement = std::move(j), r.transform = balanced;
+		}
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, judgement);

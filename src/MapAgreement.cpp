@@ -3,6 +3,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -241,22 +243,29 @@ ShiftField shiftField(
 	ShiftField f;
 	const int w = target.known.cols, h = target.known.rows;
 	const Eigen::Matrix2d a = t.linear();
-	std::map<std::pair<int, int>, std::vector<cv::Point>> tiles;
-	std::map<std::pair<int, int>, PointList> tile_sources;
+	// Each tile's points: rounded where they land in the target, and as
+	// they are in the source (the bent pass moves them again).
+	struct Tile
+	{
+		std::vector<cv::Point> landed;
+		PointList sources;
+	};
+	std::map<std::pair<int, int>, Tile> tiles;
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
 		if (!(q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach)) continue;
-		const std::pair<int, int> key{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))};
-		tiles[key].emplace_back(int(std::lround(q.x())), int(std::lround(q.y())));
-		tile_sources[key].push_back(p);
+		Tile& tile_of_q = tiles[{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))}];
+		tile_of_q.landed.emplace_back(int(std::lround(q.x())), int(std::lround(q.y())));
+		tile_of_q.sources.push_back(p);
 	}
 	// Fewer points than this fit some shift by chance: the tile says nothing.
 	constexpr size_t kMinTilePoints = 12;
 	const int steps = std::max(0, int(std::floor(reach / step)));
 	std::map<std::pair<int, int>, cv::Point> best_shift;
-	for (const auto& [key, pts] : tiles)
+	for (const auto& [key, tile_points] : tiles)
 	{
+		const std::vector<cv::Point>& pts = tile_points.landed;
 		if (pts.size() < kMinTilePoints) continue;
 		// How a point lands anywhere in the tile's window (its points' box
 		// grown by the reach), judged once: every shift reads it.
@@ -290,7 +299,12 @@ ShiftField shiftField(
 				if (any && (value > best_value || (value == best_value && norm < best_norm)))
 					best_value = value, best_norm = norm, best = d, judged = true;
 			}
-		if (judged) best_shift[key] = best;
+		if (!judged) continue;
+		best_shift[key] = best;
+		Eigen::Vector2d centroid(0, 0);
+		for (const auto& p : tile_points.sources) centroid += p;
+		centroid /= double(tile_points.sources.size());
+		f.fitted.emplace_back(centroid, t.apply(centroid) + Eigen::Vector2d(best.x, best.y));
 	}
 	// Each tile judged again, shifted as its neighbours fit best (their
 	// component-wise median; none fitted: unshifted). A smooth bend is
@@ -298,7 +312,7 @@ ShiftField shiftField(
 	// go each their own way (a wrong transform) predict nothing. Leaving the
 	// tile's own shift out keeps a tile from fitting itself onto any walls
 	// within reach, which chance does as well as the truth.
-	for (const auto& [key, pts] : tile_sources)
+	for (const auto& [key, tile_points] : tiles)
 	{
 		std::vector<int> xs, ys;
 		for (int dy = -1; dy <= 1; ++dy)
@@ -314,7 +328,7 @@ ShiftField shiftField(
 			std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
 			shifted.t += Eigen::Vector2d(xs[xs.size() / 2], ys[ys.size() / 2]);
 		}
-		const Support s = tolerantSupport(pts, source, shifted, target, tolerance, false);
+		const Support s = tolerantSupport(tile_points.sources, source, shifted, target, tolerance, false);
 		f.bent.judged += s.judged, f.bent.supported += s.supported, f.bent.conflicts += s.conflicts;
 	}
 	for (const auto& [key, d] : best_shift)
@@ -345,6 +359,19 @@ TwoWayShiftField twoWayShiftField(
 			kShiftReachCoarseCells * coarse, coarse);
 	}
 	return f;
+}
+
+Similarity2D bendBalanced(const TwoWayShiftField& f, const Similarity2D& other_to_ref)
+{
+	const size_t n = f.other_in_ref.fitted.size() + f.ref_in_other.fitted.size();
+	if (n < 3) return other_to_ref;
+	Eigen::Matrix2Xd other_cells(2, n), ref_cells(2, n);
+	size_t i = 0;
+	for (const auto& [other_centroid, in_ref] : f.other_in_ref.fitted)
+		other_cells.col(i) = other_centroid, ref_cells.col(i++) = in_ref;
+	for (const auto& [ref_centroid, in_other] : f.ref_in_other.fitted)
+		other_cells.col(i) = in_other, ref_cells.col(i++) = ref_centroid;
+	return Similarity2D::fromMatrix(Eigen::Matrix3d(Eigen::umeyama(other_cells, ref_cells, true)));
 }
 
 Chance chanceSupport(

@@ -319,6 +319,39 @@ TEST(MapAgreement, TakingOutASmoothBendRestoresTheWallsUnderTheTruthOnly)
 	EXPECT_LT(m.shifts(m.slid()).bentConsistency(), truth_unbent - 0.35);
 }
 
+TEST(MapAgreement, TheBendBalancedRefitBringsAnOffTransformBackToTheTruth)
+{
+	// Bent by up to 4 cells and placed 3 % too large and 5 cells off: each
+	// region's best shift points back to where the truth puts it, and the
+	// similarity fitted to those shifts (a vote per region) is nearer the
+	// truth over the whole map; refit again, nearer still, to about the
+	// bend's own spread.
+	const BentMalaga m(4.0);
+	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
+	Similarity2D off(1.03, 0, {0, 0});
+	off.t = centre - off.apply(centre) + Eigen::Vector2d(5, -4);
+	const Similarity2D start = off.compose(m.truth);
+	auto meanOffTruth = [&](const Similarity2D& t) {
+		double sum = 0;
+		for (const auto& p : m.bent_edges) sum += (t.apply(p) - m.truth.apply(p)).norm();
+		return sum / double(m.bent_edges.size());
+	};
+	Similarity2D refit = start;
+	std::vector<double> off_truth{meanOffTruth(start)};
+	for (int i = 0; i < 3; ++i)
+	{
+		refit = bendBalanced(m.shifts(refit), refit);
+		off_truth.push_back(meanOffTruth(refit));
+	}
+	const std::string history = ::testing::PrintToString(off_truth);
+	EXPECT_GT(off_truth[0], 8.0);
+	EXPECT_LT(off_truth[1], 0.5 * off_truth[0]) << history;
+	// The bend itself moves the walls by up to 4 coarse cells: no similarity
+	// is nearer the truth than about a coarse cell everywhere.
+	EXPECT_LT(off_truth[3], 1.5 * m.truth.scale) << "within a coarse cell and a half of the truth: " << history;
+	EXPECT_NEAR(refit.scale, m.truth.scale, 0.01 * m.truth.scale);
+}
+
 TEST(StructureHypotheses, FindATurnedRescaledRealMapWithoutFeatures)
 {
 	// The same real map at 5 and 8 cm (rendered from the scans), the coarse

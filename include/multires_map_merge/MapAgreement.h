@@ -138,6 +138,9 @@ struct ShiftField
 	 * after the shift its neighbours fit best: the walls as if a smooth bend
 	 * were taken out. */
 	Support bent;
+	/** Each fitted tile: the centroid of its points (source cells) and where
+	 * its best shift puts it (target cells). */
+	std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> fitted;
 };
 
 /** `points` (cells of the `source` map) moved by `source_to_target` into
@@ -177,6 +180,13 @@ TwoWayShiftField twoWayShiftField(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
 	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
 	size_t most_points = kJudgedPoints);
+
+/** The similarity that best takes every fitted tile of `f` (both
+ * directions, one vote per tile) to where its best shift puts it: the
+ * transform balanced over a bent map's regions, where TsICP's trimmed fit
+ * follows the part that agrees best. `other_to_ref` itself with fewer than
+ * three fitted tiles. */
+Similarity2D bendBalanced(const TwoWayShiftField& f, const Similarity2D& other_to_ref);
 
 /** The best two-way score under "far" perturbations of the transform: the
  * other map shifted by ±`shift_coarse_cells` along each axis and turned by
