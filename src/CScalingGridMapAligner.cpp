@@ -745,7 +745,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		// cell short of exact.
 		const Similarity2D full_start = s.ran && !s.may_be_exact ? s.quick.transform : h.other_to_ref;
 		mrpt::system::CTicTac clock;
-		TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
+		const TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
 		out.icp_s += clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0) || !scaleAsStated(r.transform)) return out;
 
@@ -758,24 +758,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		const bool may_be_exact = rmse_coarse < kExactMaxRmse;
 		const double cell_consistency = may_be_exact ? mapAgreement(ref_img, other_img, r.transform).consistency
 													 : std::numeric_limits<double>::quiet_NaN();
-		Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
-		// Not where the maps may be the same cells: TsICP is exact there.
-		if (options.bend_refit_iterations > 0 && !may_be_exact)
-		{
-			Similarity2D balanced = r.transform;
-			TwoWayShiftField bends = judgement.bends;
-			for (int i = 0; i < options.bend_refit_iterations; ++i)
-			{
-				balanced = bendBalanced(bends, balanced);
-				if (!balanced.isFinite() || !(balanced.scale > 0) || !scaleAsStated(balanced)) break;
-				if (i + 1 < options.bend_refit_iterations)
-					bends = twoWayShiftField(
-						ref_edges, ref_field, other_edges, other_field, balanced, options.verify_tolerance);
-			}
-			if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced))
-				if (Judgement j = decisionScore(balanced, kJudgedPoints, true); j.score > judgement.score)
-					judgement = std::move(j), r.transform = balanced;
-		}
+		const Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, judgement);
@@ -799,6 +782,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TsICPResult r;
 	};
 	std::vector<Judged> judged;
+	size_t decided = 0;  //!< index of the decided candidate (with `have`)
 	auto confidenceOfValue = [&](double value) {
 		return std::clamp(0.5 + (value - options.decision_threshold) / options.valuePerConfidence(), 0.0, 1.0);
 	};
@@ -851,6 +835,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			if (!cands[i].mirrored && (!chosen || before(i, *chosen))) chosen = i;
 		if (!chosen) return;
 		have = true;
+		decided = *chosen;
 		const TCandidate& cand = cands[*chosen];
 		const Hypothesis& h = judged[*chosen].h;
 		const TsICPResult& r = judged[*chosen].r;
@@ -1023,6 +1008,37 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	if (!have)
 		return fail(info.hypotheses ? "no hypothesis survived refinement"
 									: "no consistent feature matches or structure between the maps (do they overlap?)");
+
+	// The decided transform refit to where its regions fit best
+	// (bend_refit_iterations): independent maps bend, and TsICP's trimmed
+	// fit follows the part that agrees best. After the decision, which it
+	// does not change: a transform fitted to the judge's own measure would
+	// be judged too well (chance fits gain from it as much as right ones).
+	// Not where the maps may be the same cells (TsICP is exact there), nor
+	// for a refusal (time spent on nothing), except in calibration data,
+	// whose best candidate may merge under other parameters.
+	const TCandidate& decided_cand = info.candidates[decided];
+	if (options.bend_refit_iterations > 0 && !decided_cand.screened && !decided_cand.mirrored &&
+		info.trimmed_rmse_coarse_cells >= kExactMaxRmse &&
+		(info.confidence >= options.min_confidence || options.exhaustive_search))
+	{
+		stage.Tic();
+		Similarity2D balanced = info.cells;
+		for (int i = 0; i < options.bend_refit_iterations && balanced.isFinite() && balanced.scale > 0; ++i)
+			balanced = bendBalanced(
+				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, balanced, options.verify_tolerance),
+				balanced);
+		// Taken where the walls agree better so (its score higher).
+		if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced) &&
+			decisionScore(balanced, kJudgedPoints, false).score > decided_cand.score)
+		{
+			info.cells = balanced;
+			TCandidate& refit = info.candidates[decided];
+			refit.cells = balanced;
+			refit.other_centre = balanced.apply(other_centroid);
+		}
+		info.stage_seconds["refit"] = stage.Tac();
+	}
 
 	// The decided transform finished on the occupied cells (icp_finish_on_occupied):
 	// a fraction of a cell where the maps' walls coincide that closely. Not

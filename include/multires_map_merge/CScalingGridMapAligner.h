@@ -79,12 +79,13 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * (TCandidate::screened) instead of refined on every point. 0: off. */
 		int screen_points = 1500;
 		double screen_margin = 0.15;
-		/** After TsICP on every point, the transform is refit this many times
-		 * to the best shifts of its moved walls' tiles (bendBalanced in
-		 * MapAgreement.h: both maps, one vote per tile) and taken if its
-		 * decision score is higher; not where the maps may be the same cells.
-		 * Independent SLAM maps bend: TsICP's trimmed fit follows the part
-		 * that agrees best and is off by cells over the rest. 0: off. */
+		/** The decided transform (after the decision, which it does not
+		 * change) is refit this many times to the best shifts of its moved
+		 * walls' tiles (bendBalanced in MapAgreement.h: both maps, one vote
+		 * per tile), and taken if its decision score is higher. Independent
+		 * SLAM maps bend: TsICP's trimmed fit follows the part that agrees
+		 * best and is off by cells over the rest. Not for refusals, nor
+		 * where the maps may be the same cells. 0: off. */
 		int bend_refit_iterations = 3;
 		/** The decided transform is refined once more by TsICP on every
 		 * occupied cell of both maps (EdgePoints.h, occupiedPoints): edges
@@ -114,7 +115,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// partial maps of two buildings: without them a fit placed intel's robot
 		// in fr079), made by this code with these defaults: no wrong calibration
 		// candidate passes, with a margin (README, "How the decision works").
-		double decision_chance_weight = 1.0;
+		double decision_chance_weight = 0.5;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 200;
@@ -129,7 +130,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * map lie near one running the same way (within 20°;
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.72;
+		double decision_min_wall_alignment = 0.77;
 		/** The best candidate merges on its walls only if at least this
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
@@ -140,7 +141,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 4.0;
+		double decision_runner_up_weight = 3.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.25;
@@ -150,7 +151,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 1.171;
+		double decision_threshold = 0.825;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -198,7 +199,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	/** One refined hypothesis and how it was judged. */
 	struct TCandidate
 	{
-		Similarity2D initial_cells, cells;  //!< RANSAC start, TsICP result (cell coordinates)
+		/** RANSAC start, TsICP result (cell coordinates); the decided
+		 * candidate's after the bend-balanced refit (bend_refit_iterations). */
+		Similarity2D initial_cells, cells;
 		double overlap = 0, rmse_coarse_cells = 0;
 		/** Strict cell consistency (MapAgreement); NaN where the edge RMSE
 		 * (≥ 1.5 coarse cells) already says the maps are not the same cells. */
