@@ -8,10 +8,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numeric>
+#include <optional>
 #include <sstream>
 
 namespace multires_map_merge
@@ -173,6 +177,15 @@ int mapServerValue(double colour, bool opaque, const MapServerYaml& y)
 	return static_cast<int>(99 * (occ - y.free_thresh) / (y.occupied_thresh - y.free_thresh));
 }
 
+/** Grey walls (trinary mode): an image whose walls are drawn in grey
+ * probabilities (a probabilistic SLAM's map saved as is, a drawn plan) has
+ * many wall pixels between free_thresh and occupied_thresh, which map_server
+ * reads as unknown, losing the walls. Unexplored space is drawn in one grey:
+ * where one in-between value holds most in-between pixels, an in-between
+ * pixel darker than it by more than this (occupancy, 0.1 ≈ 25 grey levels)
+ * is read as a faint wall. Elsewhere map_server's reading stands. */
+constexpr double kFaintWallMargin = 0.1;
+
 GridInFrame loadMapServerYaml(const std::string& path)
 {
 	const MapServerYaml y = readMapServerYaml(path);
@@ -196,6 +209,33 @@ GridInFrame loadMapServerYaml(const std::string& path)
 	// map_server averages alpha in with the colour in trinary mode only.
 	const int averaged = (has_alpha && y.mode != MapServerMode::trinary) ? channels - 1 : channels;
 
+	auto colourAt = [&](const uint8_t* px) {
+		int sum = 0;
+		for (int k = 0; k < averaged; ++k) sum += px[k];
+		return double(sum) / averaged;
+	};
+	auto opaqueAt = [&](const uint8_t* px) { return !has_alpha || px[channels - 1] > 0; };
+	// The unknown grey: the commonest in-between colour (trinary mode).
+	std::optional<double> faint_wall_above;  // occupancy
+	if (y.mode == MapServerMode::trinary)
+	{
+		std::array<size_t, 256> in_between{};
+		for (int row = 0; row < img.rows; ++row)
+		{
+			const uint8_t* px = img.ptr<uint8_t>(row);
+			for (int cx = 0; cx < img.cols; ++cx, px += channels)
+				if (opaqueAt(px) && mapServerValue(colourAt(px), true, y) < 0)
+					++in_between[size_t(std::lround(colourAt(px)))];
+		}
+		const auto commonest = std::max_element(in_between.begin(), in_between.end());
+		const size_t all_in_between = std::accumulate(in_between.begin(), in_between.end(), size_t(0));
+		if (2 * *commonest > all_in_between)
+		{
+			const double grey = double(commonest - in_between.begin());
+			faint_wall_above = (255 - (y.negate ? 255 - grey : grey)) / 255.0 + kFaintWallMargin;
+		}
+	}
+
 	GridInFrame map;
 	map.origin = Similarity2D(1, y.origin[2], {y.origin[0], y.origin[1]});
 	COccupancyGridMap2D& g = map.grid;
@@ -209,10 +249,19 @@ GridInFrame loadMapServerYaml(const std::string& path)
 		const int cy = img.rows - 1 - row;  // image rows run top-down, grid rows bottom-up
 		for (int cx = 0; cx < img.cols; ++cx, px += channels)
 		{
-			int sum = 0;
-			for (int k = 0; k < averaged; ++k) sum += px[k];
-			const int v = mapServerValue(double(sum) / averaged, !has_alpha || px[channels - 1] > 0, y);
-			g.setCell(cx, cy, v < 0 ? 0.5f : 1.0f - v / 100.0f);  // MRPT stores P(free)
+			const double colour = colourAt(px);
+			const int v = mapServerValue(colour, opaqueAt(px), y);
+			float occupancy = v < 0 ? 0.5f : v / 100.0f;
+			if (v < 0 && faint_wall_above && opaqueAt(px))
+			{
+				// Between the unknown grey's occupancy and occupied_thresh
+				// onto (0.5, 1]: a wall (kOccupiedAbove), as sure as it is dark.
+				const double occ = (255 - (y.negate ? 255 - colour : colour)) / 255.0;
+				const double unknown = *faint_wall_above - kFaintWallMargin;
+				if (occ > *faint_wall_above && y.occupied_thresh > unknown)
+					occupancy = float(std::min(1.0, 0.5 + 0.5 * (occ - unknown) / (y.occupied_thresh - unknown)));
+			}
+			g.setCell(cx, cy, 1.0f - occupancy);  // MRPT stores P(free)
 		}
 	}
 	return map;

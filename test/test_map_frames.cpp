@@ -427,3 +427,26 @@ TEST(MapFrames, RotatedYamlOriginGivesTheUnrotatedTransformReexpressed)
 	EXPECT_NEAR(in_ref_cells.x(), std::round(in_ref_cells.x()), 1e-4);
 	EXPECT_NEAR(in_ref_cells.y(), std::round(in_ref_cells.y()), 1e-4);
 }
+
+TEST(MapServerModes, GreyWallsDarkerThanTheUnknownGreyAreWalls)
+{
+	// A probabilistic map saved as is: unexplored space in one grey (205,
+	// occupancy 0.196), walls in greys between the thresholds. map_server
+	// reads every one of them as unknown; darker than the unknown grey by
+	// more than 0.1 (150: 0.41) they are walls, as sure as they are dark;
+	// a grey near the unknown one (190: 0.25) stays unknown, as do lighter
+	// ones, and free and occupied pixels read as map_server reads them.
+	cv::Mat image(1, 40, CV_8UC1, cv::Scalar(205));
+	const std::vector<uint8_t> greys = {0, 100, 150, 190, 200, 254};
+	for (size_t i = 0; i < greys.size(); ++i) image.at<uint8_t>(0, int(i)) = greys[i];
+	const std::vector<int> got = row(loadRow("grey_walls", "", image));
+	EXPECT_EQ(got[0], 100);
+	EXPECT_GT(got[1], 60) << "0.61 occupancy: a wall";
+	EXPECT_GT(got[2], 55) << "0.41 occupancy: a fainter wall";
+	EXPECT_LT(got[2], got[1]);
+	EXPECT_EQ(classify(occupancyProbability(loadGridMap(tmp("grey_walls.yaml")).grid, 2, 0)), kOccupied);
+	EXPECT_EQ(got[3], -1) << "within 0.1 of the unknown grey";
+	EXPECT_EQ(got[4], -1);
+	EXPECT_EQ(got[5], 0);
+	EXPECT_EQ(got[6], -1) << "unexplored";
+}

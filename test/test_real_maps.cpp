@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include "../bench/halmstad.h"
@@ -264,4 +265,44 @@ TEST(RealMaps, WillowNavstage5cmAgainstStageros10cm)
 	for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
 		EXPECT_LE((r.metric(corner) - reference(corner)).norm(), 0.6) << corner.transpose();
 	EXPECT_NEAR(r.implied_resolution_other, 0.1, 0.001);
+}
+
+// Walls drawn in grey probabilities (a probabilistic SLAM's map saved as is):
+// map_server's trinary reading calls every pixel between the thresholds
+// unknown and loses such walls. The navstage map with every pixel darker
+// than 180 redrawn grey 150 (occupancy 0.41, under occupied_thresh 0.65):
+// not one pixel is occupied for map_server, yet read as faint walls (darker
+// than the unknown grey 205 by more than 0.1) it merges with stageros as
+// the original does. Unexplored space (205) and the free space stay as they
+// were.
+TEST(RealMaps, FaintGreyWallsAreReadAsWalls)
+{
+	MMM_REQUIRE_SHARED(ref_yaml, "ros_maps/willow/navstage_willow_5cm.yaml");
+	MMM_REQUIRE_SHARED(ref_pgm, "ros_maps/willow/navstage_willow_5cm.pgm");
+	MMM_REQUIRE_SHARED(other_yaml, "ros_maps/willow/stageros_willow_10cm.yaml");
+	cv::Mat grey_walls = cv::imread(ref_pgm, cv::IMREAD_UNCHANGED);
+	ASSERT_FALSE(grey_walls.empty());
+	const int walls = cv::countNonZero(grey_walls < 180);
+	ASSERT_GT(walls, 10000);
+	grey_walls.setTo(150, grey_walls < 180);
+	const std::string pgm = dir() + "/grey_walls.pgm", yaml = dir() + "/grey_walls.yaml";
+	ASSERT_TRUE(cv::imwrite(pgm, grey_walls));
+	std::ofstream(yaml) << "image: grey_walls.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+						<< "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	EXPECT_EQ(cv::countNonZero(grey_walls < 89), 0) << "map_server would read no wall at all";
+
+	const GridInFrame faint = loadGridMap(yaml), original = loadGridMap(ref_yaml);
+	const cv::Mat faint_classes = toClassImage(faint.grid), original_classes = toClassImage(original.grid);
+	EXPECT_EQ(cv::countNonZero(faint_classes == kOccupied), cv::countNonZero(original_classes == kOccupied))
+		<< "the same walls, read from grey";
+	EXPECT_EQ(cv::countNonZero(faint_classes == kUnknown), cv::countNonZero(original_classes == kUnknown));
+
+	const GridInFrame other = loadGridMap(other_yaml);
+	const auto from_grey = CScalingGridMapAligner().alignScaled(faint, other);
+	const auto from_original = CScalingGridMapAligner().alignScaled(original, other);
+	ASSERT_TRUE(from_grey.success) << from_grey.message;
+	ASSERT_TRUE(from_original.success) << from_original.message;
+	const double w = other.grid.getXMax() - other.grid.getXMin(), h = other.grid.getYMax() - other.grid.getYMin();
+	for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
+		EXPECT_LE((from_grey.metric(corner) - from_original.metric(corner)).norm(), 0.3) << corner.transpose();
 }
