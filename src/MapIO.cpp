@@ -157,20 +157,26 @@ MapServerYaml readMapServerYaml(const std::string& path)
 	return y;
 }
 
+/** A pixel's occupancy in [0, 1] as map_server reads it (trinary and scale
+ * modes): dark is occupied, unless `negate`. */
+double pixelOccupancy(double colour, const MapServerYaml& y)
+{
+	return (y.negate ? colour : 255 - colour) / 255.0;
+}
+
 /** Occupancy in 0..100, or -1 for unknown, of one pixel: map_server's rules.
  * `colour` is the channel mean (alpha included in trinary mode, as
  * map_server does), `opaque` false for a fully transparent pixel. */
 int mapServerValue(double colour, bool opaque, const MapServerYaml& y)
 {
-	if (y.negate) colour = 255 - colour;
 	if (y.mode == MapServerMode::raw)
 	{
 		// map_server copies the byte into an int8: 0..100 are occupancies,
 		// 255 reads as -1 (unknown); anything else is no occupancy at all.
-		const int v = static_cast<int>(colour);
+		const int v = static_cast<int>(y.negate ? 255 - colour : colour);
 		return v <= 100 ? v : -1;
 	}
-	const double occ = (255 - colour) / 255.0;
+	const double occ = pixelOccupancy(colour, y);
 	if (occ > y.occupied_thresh) return 100;
 	if (occ < y.free_thresh) return 0;
 	if (y.mode == MapServerMode::trinary || !opaque) return -1;
@@ -224,15 +230,17 @@ GridInFrame loadMapServerYaml(const std::string& path)
 		{
 			const uint8_t* px = img.ptr<uint8_t>(row);
 			for (int cx = 0; cx < img.cols; ++cx, px += channels)
-				if (opaqueAt(px) && mapServerValue(colourAt(px), true, y) < 0)
-					++in_between[size_t(std::lround(colourAt(px)))];
+			{
+				const double colour = colourAt(px);
+				if (opaqueAt(px) && mapServerValue(colour, true, y) < 0) ++in_between[size_t(std::lround(colour))];
+			}
 		}
 		const auto commonest = std::max_element(in_between.begin(), in_between.end());
 		const size_t all_in_between = std::accumulate(in_between.begin(), in_between.end(), size_t(0));
 		if (2 * *commonest > all_in_between)
 		{
 			const double grey = double(commonest - in_between.begin());
-			faint_wall_above = (255 - (y.negate ? 255 - grey : grey)) / 255.0 + kFaintWallMargin;
+			faint_wall_above = pixelOccupancy(grey, y) + kFaintWallMargin;
 		}
 	}
 
@@ -256,7 +264,7 @@ GridInFrame loadMapServerYaml(const std::string& path)
 			{
 				// Between the unknown grey's occupancy and occupied_thresh
 				// onto (0.5, 1]: a wall (kOccupiedAbove), as sure as it is dark.
-				const double occ = (255 - (y.negate ? 255 - colour : colour)) / 255.0;
+				const double occ = pixelOccupancy(colour, y);
 				const double unknown = *faint_wall_above - kFaintWallMargin;
 				if (occ > *faint_wall_above && y.occupied_thresh > unknown)
 					occupancy = float(std::min(1.0, 0.5 + 0.5 * (occ - unknown) / (y.occupied_thresh - unknown)));
