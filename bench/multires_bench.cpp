@@ -986,6 +986,25 @@ std::vector<HalmstadRun> runHalmstad(
 	return runs;
 }
 
+/** Calibration negatives in the other order: each map of another site as
+ * REF against `per_map` E5 maps as OTHER. The decision is not symmetric in
+ * its maps, and the report's cross-site negatives take every site's maps as
+ * REF; runHalmstad's calibration negatives take only E5 and HIH maps. */
+void runReverseCrossSiteNegatives(const HalmstadData& data, size_t per_map)
+{
+	const std::string dir = (fs::temp_directory_path() / ("multires_bench_reverse_" + std::to_string(getpid()))).string();
+	const std::vector<std::string> e5 = data.sensorMaps("E5");
+	for (const auto& site : data.sites())
+		if (site != "E5")
+			for (const auto& ref : data.sensorMaps(site))
+			{
+				// Spread over the E5 maps from a per-map offset, as runHalmstad's.
+				const size_t start = std::hash<std::string>()(ref) % e5.size();
+				for (size_t k = 0; k < per_map; ++k) runHalmstadPair(data, ref, e5[(start + k * 5) % e5.size()], dir);
+			}
+	fs::remove_all(dir);
+}
+
 /** The accuracy matrices alone (no MRPT, no report): for work on accuracy. */
 int runAccuracySets(const std::string& list)
 {
@@ -1091,6 +1110,7 @@ int main(int argc, char** argv)
 			if (!extra_arg.getValue() && !live_pairs_arg.getValue())
 			{
 				runHalmstad(data, {"E5", "HIH"}, negatives_arg.getValue());
+				runReverseCrossSiteNegatives(data, negatives_arg.getValue());
 				runCarmenNegatives(false);
 			}
 			if (!live_pairs_arg.getValue()) runExtraCalibrationNegatives(data);
