@@ -135,7 +135,7 @@ std::ofstream g_candidates;
 const char* kCandidateHeader =
 	"site,ref,other,positive,calibration,index,right,error,scale,overlap,rmse_coarse,consistency,support,"
 	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error,screened,yaw_deg,centre_x,"
-	"centre_y,mirrored,chance_support,wall_alignment,shift_coherence,bent_consistency\n";
+	"centre_y,mirrored,chance_support,wall_alignment,shift_coherence,bent_consistency,feature_agreement\n";
 
 /** The options every aligner of the benchmark runs with: the defaults, except
  * for --calibration-data, which refines every hypothesis and always searches
@@ -169,7 +169,8 @@ void writeCandidates(
 					 << c.tolerant_consistency << "," << c.chance_consistency << "," << c.score << ","
 					 << c.confidence << "," << init.first << "," << c.screened << "," << c.cells.yaw * 180 / M_PI << ","
 					 << c.other_centre.x() << "," << c.other_centre.y() << "," << c.mirrored << "," << c.chance_support << ","
-					 << c.wall_alignment << "," << c.shift_coherence << "," << c.bent_consistency << "\n";
+					 << c.wall_alignment << "," << c.shift_coherence << "," << c.bent_consistency << ","
+					 << c.feature_agreement << "\n";
 	}
 }
 

@@ -20,6 +20,7 @@ are the acceptance set and are never read here.
 
 The decision (src/CScalingGridMapAligner.cpp) scores each refined candidate by
     score = B + chance_weight * (B - C) - sqrt(evidence / n)
+            + feature_weight * min(F, feature_cap) / feature_cap
 where T is the tolerant consistency (share of both maps' wall points moved
 onto seen space that do not land on clearly free space), B the same with
 each tile of 30 coarse cells of the moved walls shifted as its neighbours
@@ -29,7 +30,10 @@ chance gives in these maps), and n
 the number of wall points judged (the weaker direction): neighbouring wall
 points are far from independent, so a T measured on a small overlap (a map
 shrunk into a corner of the other) is discounted like a proportion from few
-samples. The pair is then decided on its best-scoring candidate by
+samples, and F the number of SIFT matches between the maps (RANSAC's
+input) that the transform takes onto each other: local appearance agreeing,
+evidence beside the walls between look-alike buildings. The pair is then
+decided on its best-scoring candidate by
     value = score + runner_up_weight * (score - max(floor, rival))
 where rival is the best score of a candidate that puts the other map
 elsewhere (its wall centroid more than distinct_shift coarse cells away,
@@ -51,14 +55,16 @@ of adjacent tiles whose shifts agree within the tolerance) reaches the
 minimum: SLAM bends a map smoothly, a wrong alignment that lays walls near
 walls fits each region by a shift of its own.
 
-This script picks chance_weight, evidence, runner_up_weight, floor, the
+This script picks chance_weight, evidence, feature_weight and feature_cap,
+runner_up_weight, floor, the
 minimum lead, the minimum wall alignment and the minimum shift coherence
 (the most right merges; ties go to the fit that asks most of a candidate
 with no rival, i.e. the highest lowest mergeable score
 (threshold + runner_up_weight * floor) / (1 + runner_up_weight), to three
 decimals: a best candidate alone, as on a small overlap or a map of a new
 building, is what the calibration data checks least, and the screen drops
-more below a higher bar; then to the smaller runner-up weight, then the
+more below a higher bar; then to the smaller runner-up weight, the smaller
+feature weight (the walls are what the data checks most), then the
 larger chance weight, evidence, floor, minimum lead, wall alignment and
 shift coherence: the safer where it costs nothing; a coherence gate must
 stay COHERENCE_MARGIN below every right best candidate's) and sets
@@ -119,6 +125,9 @@ LEADS = [0.0, 0.02, 0.04]
 ALIGNMENTS = [0.0, 0.7, 0.72, 0.74, 0.75, 0.76, 0.77, 0.78, 0.8]
 # decision_min_shift_coherence (0: no gate).
 COHERENCES = [0.0, 0.2, 0.25, 0.3]
+# decision_feature_weight and decision_feature_cap: the score gains
+# weight * min(m, cap) / cap for m agreeing feature matches (0: walls only).
+FEATURES = [(0.0, 20)] + [(fw, cap) for fw in [0.1, 0.2, 0.4] for cap in [10, 20, 40]]
 TOP_FITS = 20
 DISTINCT_SHIFT = 20.0  # coarse cells (the aligner's distinct_shift)
 TURN_DEG = 8.0  # the aligner's verify_turn_deg
@@ -154,6 +163,8 @@ def load(paths):
                     # Absent from data written before it was measured: no gate there.
                     "A": float(r.get("wall_alignment") or "nan"),
                     "H": float(r.get("shift_coherence") or "nan"),
+                    # Absent from data written before it was measured: none.
+                    "F": int(r.get("feature_agreement") or 0),
                     "n": max(1, int(r["judged"])),
                     "scale": float(r["scale"]),
                     "yaw": math.radians(float(r["yaw_deg"])),
@@ -193,52 +204,53 @@ def main():
           f"{len(pairs) - len(positives) - len(live)} negative pairs")
     best = None
     fits = []  # (rank, runner-up weight, line) of every combination tried
-    for w in WEIGHTS:
-        for e in EVIDENCE:
-            def score(r):
-                return r["B"] + w * (r["B"] - r["C"]) - math.sqrt(e / r["n"])
-            scores = {id(r): score(r) for r in rows}
-            tops = {}
-            for key, c in pairs.items():
-                judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
-                if judged:
-                    tops[key] = max(judged, key=lambda r: scores[id(r)])
-            # A coherence gate is for the wrong tops: one that some right best
-            # candidate does not clear by the margin would trim merges of new
-            # maps for no gain here.
-            right_tops = [tops[key]["H"] for key in positives if key in tops and tops[key]["right"]]
-            cohs = [h for h in COHERENCES if not right_tops or h <= min(right_tops) - COHERENCE_MARGIN]
-            for k, floor, lead, align, coh in itertools.product(RUNNER_UP, FLOORS, LEADS, ALIGNMENTS, cohs):
-                def value(top):
-                    s = scores[id(top)]
-                    rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
-                    return s + k * (s - rival)
-                # A top not leading chance by `lead`, whose near walls run
-                # alike less than `align`, or whose regions shift alike less
-                # than `coh`, cannot merge: below any threshold. Wrong tops
-                # within the gates' margins count as through them.
-                def through(top, lead_margin, align_margin, coh_margin):
-                    return (top["B"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
-                            and not top["H"] < coh - coh_margin)
-                values = {key: value(top) if through(top, 0, 0, 0) else -math.inf for key, top in tops.items()}
-                wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN, COHERENCE_MARGIN) else -math.inf
-                         for key, top in tops.items() if not top["right"] and not top["near"]]
-                threshold = max(wrong) + MARGIN * (1 + k)
-                merged_right = sum(1 for key in positives
-                                   if key in tops and tops[key]["right"] and values[key] >= threshold)
-                live_right = sum(1 for key in live
-                                 if key in tops and tops[key]["right"] and values[key] >= threshold)
-                lowest_mergeable = round((threshold + k * floor) / (1 + k), 3)
-                rank = (merged_right, lowest_mergeable, -k, w, e, floor, lead, align, coh)
-                fits.append((rank, k,
-                             f"  chance_weight {w:4.2f} evidence {e:4d} runner_up_weight {k:3.1f} floor {floor:5.2f} "
-                             f"lead {lead:4.2f} alignment {align:4.2f} coherence {coh:4.2f}: "
-                             f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
-                             f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}"))
-                if best is None or rank > best[0]:
-                    per_file = collections.Counter(
-                        key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
-                    best = (rank, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file)
+    for w, e, (fw, fcap) in itertools.product(WEIGHTS, EVIDENCE, FEATURES):
+        def score(r):
+            return r["B"] + w * (r["B"] - r["C"]) - math.sqrt(e / r["n"]) + fw * min(r["F"], fcap) / fcap
+        scores = {id(r): score(r) for r in rows}
+        tops = {}
+        for key, c in pairs.items():
+            judged = [r for r in c if not r["screened"] and not r["mirrored"] and r["n"] >= MIN_JUDGED]
+            if judged:
+                tops[key] = max(judged, key=lambda r: scores[id(r)])
+        # A coherence gate is for the wrong tops: one that some right best
+        # candidate does not clear by the margin would trim merges of new
+        # maps for no gain here.
+        right_tops = [tops[key]["H"] for key in positives if key in tops and tops[key]["right"]]
+        cohs = [h for h in COHERENCES if not right_tops or h <= min(right_tops) - COHERENCE_MARGIN]
+        for k, floor, lead, align, coh in itertools.product(RUNNER_UP, FLOORS, LEADS, ALIGNMENTS, cohs):
+            def value(top):
+                s = scores[id(top)]
+                rival = max([floor] + [scores[id(o)] for o in rivals[id(top)]])
+                return s + k * (s - rival)
+            # A top not leading chance by `lead`, whose near walls run
+            # alike less than `align`, or whose regions shift alike less
+            # than `coh`, cannot merge: below any threshold. Wrong tops
+            # within the gates' margins count as through them.
+            def through(top, lead_margin, align_margin, coh_margin):
+                return (top["B"] - top["C"] >= lead - lead_margin and not top["A"] < align - align_margin
+                        and not top["H"] < coh - coh_margin)
+            values = {key: value(top) if through(top, 0, 0, 0) else -math.inf for key, top in tops.items()}
+            wrong = [value(top) if through(top, LEAD_MARGIN, ALIGNMENT_MARGIN, COHERENCE_MARGIN) else -math.inf
+                     for key, top in tops.items() if not top["right"] and not top["near"]]
+            threshold = max(wrong) + MARGIN * (1 + k)
+            merged_right = sum(1 for key in positives
+                               if key in tops and tops[key]["right"] and values[key] >= threshold)
+            live_right = sum(1 for key in live
+                             if key in tops and tops[key]["right"] and values[key] >= threshold)
+            lowest_mergeable = round((threshold + k * floor) / (1 + k), 3)
+            rank = (merged_right, lowest_mergeable, -k, -fw, w, e, floor, lead, align, coh, fcap)
+            fits.append((rank, k,
+                         f"  chance_weight {w:4.2f} evidence {e:4d} features {fw:3.1f}/{fcap:2d} "
+                         f"runner_up_weight {k:3.1f} floor {floor:5.2f} "
+                         f"lead {lead:4.2f} alignment {align:4.2f} coherence {coh:4.2f}: "
+                         f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
+                         f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}"))
+            if best is None or rank > best[0]:
+                per_file = collections.Counter(
+                    key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
+                best = (rank, w, e, fw, fcap, k, floor, lead, align, coh, threshold, merged_right, live_right,
+                        per_file)
     if show_all:
         print("every fit tried:")
         for _, _, line in fits:
@@ -250,8 +262,9 @@ def main():
         print(f"the {TOP_FITS} best fits (of {len(fits)}; --all prints every one):")
         for _, _, line in sorted(fits, key=lambda f: f[0], reverse=True)[:TOP_FITS]:
             print(line)
-    _, w, e, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file = best
-    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\ndecision_min_lead = {lead}\n"
+    _, w, e, fw, fcap, k, floor, lead, align, coh, threshold, merged_right, live_right, per_file = best
+    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
+          f"decision_feature_weight = {fw}\ndecision_feature_cap = {fcap}\ndecision_min_lead = {lead}\n"
           f"decision_min_wall_alignment = {align}\ndecision_min_shift_coherence = {coh}\n"
           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\n"
           f"decision_threshold = {threshold:.3f}")

@@ -61,6 +61,8 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_chance_weight, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_evidence, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_feature_weight, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(decision_feature_cap, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_lead, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_wall_alignment, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(decision_min_shift_coherence, double, c, s);
@@ -110,6 +112,8 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
 	in("decision_chance_weight", decision_chance_weight, 0, 10);
 	in("decision_evidence", decision_evidence, 0, 1e6);
+	in("decision_feature_weight", decision_feature_weight, 0, 10);
+	in("decision_feature_cap", decision_feature_cap, 1, 1e6);
 	in("decision_min_lead", decision_min_lead, -1, 1);
 	in("decision_min_wall_alignment", decision_min_wall_alignment, 0, 1);
 	in("decision_min_shift_coherence", decision_min_shift_coherence, 0, 1);
@@ -153,8 +157,10 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
-	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = T + w (T - chance T) - sqrt(evidence / judged)");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_chance_weight, "Score = B + w (B - chance T) - sqrt(evidence / judged) + feature term");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_evidence, "Evidence discount of small overlaps [wall points]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_feature_weight, "Score gained at decision_feature_cap agreeing feature matches");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_feature_cap, "Agreeing feature matches beyond this gain no more");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_lead, "Merged on its walls only if they agree more than chance by this");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_wall_alignment, "Merged on its walls only if this share of near walls run alike");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(decision_min_shift_coherence, "Merged on its walls only if this share of adjacent regions fit after alike shifts");
@@ -583,6 +589,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	if (ref_edges.size() < 10 || other_edges.size() < 10)
 		return fail("too few occupied cells bordering free space to register the maps");
 
+	// Feature matches of every pyramid level pair: RANSAC's input, and
+	// evidence of each candidate (decision_feature_weight).
+	stage.Tic();
+	const std::vector<LevelMatches> matches = featureMatches(ref.features, other.features, fp);
+	info.stage_seconds["matches"] = stage.Tac();
+
 	// 3. TsICP from each hypothesis; 4. judge each on the cells. The best
 	// confidence wins; ψ breaks ties between equally trusted refinements.
 	const TsICPParams ip = options.icpParams();
@@ -606,6 +618,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TwoWaySupport sup;
 		Chance chance;
 		TwoWayShiftField bends;
+		size_t feature_agreement = 0;
 		double score = 0;
 	};
 	auto decisionScore = [&](const Similarity2D& t, size_t most, bool in_full) {
@@ -623,9 +636,19 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		// Judged as if a smooth bend were taken out (TwoWayShiftField): two
 		// SLAM runs of one building differ by one.
 		const double bc = j.bends.bentConsistency();
+		j.feature_agreement = agreeingMatches(matches, t);
 		j.score = bc + options.decision_chance_weight * (bc - j.chance.consistency) -
-			std::sqrt(options.decision_evidence / std::max(1.0, judged));
+			std::sqrt(options.decision_evidence / std::max(1.0, judged)) +
+			options.decision_feature_weight * std::min(double(j.feature_agreement), options.decision_feature_cap) /
+				options.decision_feature_cap;
 		return j;
+	};
+	// The transform refit to where its regions fit best (bend_refit_iterations).
+	auto bendRefit = [&](Similarity2D t) {
+		for (int i = 0; i < options.bend_refit_iterations && t.isFinite() && t.scale > 0; ++i)
+			t = bendBalanced(
+				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance), t);
+		return t;
 	};
 	Eigen::Vector2d other_centroid(0, 0);
 	for (const auto& p : other_edges) other_centroid += p;
@@ -646,6 +669,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		c.wall_alignment = sup.wallAlignment();
 		c.bent_consistency = j.bends.bentConsistency();
 		c.shift_coherence = j.bends.coherence();
+		c.feature_agreement = j.feature_agreement;
 		c.judged_points = sup.judged();
 		c.score = j.score;
 		c.other_centre = r.transform.apply(other_centroid);
@@ -745,7 +769,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		// cell short of exact.
 		const Similarity2D full_start = s.ran && !s.may_be_exact ? s.quick.transform : h.other_to_ref;
 		mrpt::system::CTicTac clock;
-		const TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
+		TsICPResult r = refineFromTheInside(ref, other, full_start, ip);
 		out.icp_s += clock.Tac();
 		if (!r.transform.isFinite() || !(r.transform.scale > 0) || !scaleAsStated(r.transform)) return out;
 
@@ -758,7 +782,15 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		const bool may_be_exact = rmse_coarse < kExactMaxRmse;
 		const double cell_consistency = may_be_exact ? mapAgreement(ref_img, other_img, r.transform).consistency
 													 : std::numeric_limits<double>::quiet_NaN();
-		const Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
+		Judgement judgement = decisionScore(r.transform, kJudgedPoints, true);
+		// Refit to where its regions fit best (bend_refit_iterations).
+		if (options.bend_refit_iterations > 0 && !may_be_exact)
+		{
+			const Similarity2D balanced = bendRefit(r.transform);
+			if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced))
+				if (Judgement j = decisionScore(balanced, kJudgedPoints, true); j.score > judgement.score)
+					judgement = std::move(j), r.transform = balanced;
+		}
 		out.verify_s += clock.Tac();
 		TCandidate& cand = out.cand;
 		cand = candidate(h, r, rmse_coarse, cell_consistency, judgement);
@@ -782,7 +814,6 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		TsICPResult r;
 	};
 	std::vector<Judged> judged;
-	size_t decided = 0;  //!< index of the decided candidate (with `have`)
 	auto confidenceOfValue = [&](double value) {
 		return std::clamp(0.5 + (value - options.decision_threshold) / options.valuePerConfidence(), 0.0, 1.0);
 	};
@@ -835,7 +866,6 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			if (!cands[i].mirrored && (!chosen || before(i, *chosen))) chosen = i;
 		if (!chosen) return;
 		have = true;
-		decided = *chosen;
 		const TCandidate& cand = cands[*chosen];
 		const Hypothesis& h = judged[*chosen].h;
 		const TsICPResult& r = judged[*chosen].r;
@@ -848,6 +878,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		info.chance_consistency = cand.chance_consistency;
 		info.wall_alignment = cand.wall_alignment;
 		info.shift_coherence = cand.shift_coherence;
+		info.feature_agreement = cand.feature_agreement;
 		info.bent_consistency = cand.bent_consistency;
 		info.score = cand.score;
 		info.runner_up_score = cand.runner_up_score;
@@ -952,7 +983,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	{
 		stage.Tic();
 		const auto hyps =
-			featureHypotheses(ref.features, other.features, fp, expected_scale, options.metadata_scale_tolerance);
+			featureHypotheses(matches, fp, expected_scale, options.metadata_scale_tolerance);
 		info.stage_seconds["ransac"] = stage.Tac();
 		info.hypotheses += hyps.size();
 		refineAll(hyps);
@@ -1008,37 +1039,6 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	if (!have)
 		return fail(info.hypotheses ? "no hypothesis survived refinement"
 									: "no consistent feature matches or structure between the maps (do they overlap?)");
-
-	// The decided transform refit to where its regions fit best
-	// (bend_refit_iterations): independent maps bend, and TsICP's trimmed
-	// fit follows the part that agrees best. After the decision, which it
-	// does not change: a transform fitted to the judge's own measure would
-	// be judged too well (chance fits gain from it as much as right ones).
-	// Not where the maps may be the same cells (TsICP is exact there), nor
-	// for a refusal (time spent on nothing), except in calibration data,
-	// whose best candidate may merge under other parameters.
-	const TCandidate& decided_cand = info.candidates[decided];
-	if (options.bend_refit_iterations > 0 && !decided_cand.screened && !decided_cand.mirrored &&
-		info.trimmed_rmse_coarse_cells >= kExactMaxRmse &&
-		(info.confidence >= options.min_confidence || options.exhaustive_search))
-	{
-		stage.Tic();
-		Similarity2D balanced = info.cells;
-		for (int i = 0; i < options.bend_refit_iterations && balanced.isFinite() && balanced.scale > 0; ++i)
-			balanced = bendBalanced(
-				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, balanced, options.verify_tolerance),
-				balanced);
-		// Taken where the walls agree better so (its score higher).
-		if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced) &&
-			decisionScore(balanced, kJudgedPoints, false).score > decided_cand.score)
-		{
-			info.cells = balanced;
-			TCandidate& refit = info.candidates[decided];
-			refit.cells = balanced;
-			refit.other_centre = balanced.apply(other_centroid);
-		}
-		info.stage_seconds["refit"] = stage.Tac();
-	}
 
 	// The decided transform finished on the occupied cells (icp_finish_on_occupied):
 	// a fraction of a cell where the maps' walls coincide that closely. Not

@@ -122,48 +122,86 @@ bool sameHypothesis(const Similarity2D& a, const Similarity2D& b)
 }
 }  // namespace
 
+std::vector<LevelMatches> featureMatches(
+	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other, const FeatureParams& p)
+{
+	cv::BFMatcher matcher(cv::NORM_L2);
+	std::vector<LevelMatches> all;
+	for (size_t i = 0; i < ref.size(); ++i)
+		for (size_t j = 0; j < other.size(); ++j)
+		{
+			LevelMatches lm;
+			lm.level_scale = other[j].scale / ref[i].scale;
+			lm.tolerance = p.ransac_threshold / ref[i].scale;
+			lm.ref_level = static_cast<int>(i), lm.other_level = static_cast<int>(j);
+			if (ref[i].descriptors.rows >= 2 && other[j].descriptors.rows >= 2)
+			{
+				std::vector<std::vector<cv::DMatch>> knn;
+				matcher.knnMatch(other[j].descriptors, ref[i].descriptors, knn, 2);
+				for (const auto& m : knn)
+					if (m.size() == 2 && m[0].distance < p.ratio_test * m[1].distance)
+					{
+						lm.from.push_back(other[j].points[m[0].queryIdx]);
+						lm.to.push_back(ref[i].points[m[0].trainIdx]);
+					}
+			}
+			all.push_back(std::move(lm));
+		}
+	return all;
+}
+
+size_t agreeingMatches(const std::vector<LevelMatches>& matches, const Similarity2D& other_to_ref)
+{
+	size_t n = 0;
+	for (const auto& lm : matches)
+	{
+		if (std::abs(std::log(other_to_ref.scale / lm.level_scale)) > 0.5 * std::log(2.0)) continue;
+		for (size_t k = 0; k < lm.from.size(); ++k)
+			if ((other_to_ref.apply(Eigen::Vector2d(lm.from[k].x, lm.from[k].y)) -
+				 Eigen::Vector2d(lm.to[k].x, lm.to[k].y))
+					.norm() <= lm.tolerance)
+				++n;
+	}
+	return n;
+}
+
 std::vector<Hypothesis> featureHypotheses(
 	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other,
 	const FeatureParams& p, std::optional<double> expected_scale, double scale_tolerance)
 {
-	cv::BFMatcher matcher(cv::NORM_L2);
+	return featureHypotheses(featureMatches(ref, other, p), p, expected_scale, scale_tolerance);
+}
+
+std::vector<Hypothesis> featureHypotheses(
+	const std::vector<LevelMatches>& matches, const FeatureParams& p, std::optional<double> expected_scale,
+	double scale_tolerance)
+{
 	std::vector<Hypothesis> found;
-	for (size_t i = 0; i < ref.size(); ++i)
-		for (size_t j = 0; j < other.size(); ++j)
+	for (const LevelMatches& lm : matches)
+	{
+		std::vector<cv::Point2f> from = lm.from, to = lm.to;
+		const double thr = lm.tolerance;
+		// Levels of equal cell size match best: this pair looks for a
+		// scale near other level / ref level, within a factor of 2 (the
+		// neighbouring level pairs cover the rest).
+		const double level_scale = lm.level_scale;
+		for (int k = 0; k < p.hypotheses_per_level_pair; ++k)
 		{
-			if (ref[i].descriptors.rows < 2 || other[j].descriptors.rows < 2) continue;
-			std::vector<std::vector<cv::DMatch>> knn;
-			matcher.knnMatch(other[j].descriptors, ref[i].descriptors, knn, 2);
-			std::vector<cv::Point2f> from, to;
-			for (const auto& m : knn)
-				if (m.size() == 2 && m[0].distance < p.ratio_test * m[1].distance)
-				{
-					from.push_back(other[j].points[m[0].queryIdx]);
-					to.push_back(ref[i].points[m[0].trainIdx]);
-				}
-			const double thr = p.ransac_threshold / ref[i].scale;
-			// Levels of equal cell size match best: this pair looks for a
-			// scale near other level / ref level, within a factor of 2 (the
-			// neighbouring level pairs cover the rest).
-			const double level_scale = other[j].scale / ref[i].scale;
-			for (int k = 0; k < p.hypotheses_per_level_pair; ++k)
-			{
-				std::vector<uchar> mask;
-				auto s = ransacSimilarity(
-					from, to, thr, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask, level_scale / 2,
-					level_scale * 2);
-				if (!s) break;
-				found.push_back({*s, cv::countNonZero(mask), static_cast<int>(from.size()),
-								 static_cast<int>(i), static_cast<int>(j)});
-				// Re-run on the matches this model did not explain: a second
-				// building wing, or a symmetric twin, gets its own chance.
-				std::vector<cv::Point2f> f2, t2;
-				for (size_t q = 0; q < mask.size(); ++q)
-					if (!mask[q]) f2.push_back(from[q]), t2.push_back(to[q]);
-				from.swap(f2);
-				to.swap(t2);
-			}
+			std::vector<uchar> mask;
+			auto s = ransacSimilarity(
+				from, to, thr, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask, level_scale / 2,
+				level_scale * 2);
+			if (!s) break;
+			found.push_back({*s, cv::countNonZero(mask), static_cast<int>(from.size()), lm.ref_level, lm.other_level});
+			// Re-run on the matches this model did not explain: a second
+			// building wing, or a symmetric twin, gets its own chance.
+			std::vector<cv::Point2f> f2, t2;
+			for (size_t q = 0; q < mask.size(); ++q)
+				if (!mask[q]) f2.push_back(from[q]), t2.push_back(to[q]);
+			from.swap(f2);
+			to.swap(t2);
 		}
+	}
 	if (expected_scale)
 		found.erase(
 			std::remove_if(found.begin(), found.end(), [&](const Hypothesis& h) {

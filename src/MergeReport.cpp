@@ -35,6 +35,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"chance_consistency", num(r.chance_consistency)},
 		{"wall_alignment", num(r.wall_alignment)},
 		{"shift_coherence", num(r.shift_coherence)},
+		{"feature_agreement", r.feature_agreement},
 		{"bent_consistency", num(r.bent_consistency)},
 		{"score", num(r.score)},
 		{"runner_up_score", num(r.runner_up_score)},

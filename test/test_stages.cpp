@@ -208,6 +208,25 @@ TEST(MapAgreement, TolerantConsistencyIsAPeakAboveChance)
 	EXPECT_LT(m.at(Similarity2D(1, 0, {60, 0})).consistency(), at_truth.consistency() - 0.15);
 }
 
+TEST(FeatureHypotheses, MatchesAgreeUnderTheTruthNotElsewhere)
+{
+	// The decision's feature evidence (agreeingMatches): SIFT matches of the
+	// real 5 cm / 10 cm pair that the truth takes onto each other (22 here);
+	// turned by 45° about the map's centre or slid 30 coarse cells, none.
+	const MalagaSupport m;
+	FeatureParams p;
+	const auto matches = featureMatches(extractPyramidFeatures(m.a, p), extractPyramidFeatures(m.b, p), p);
+	const size_t at_truth = agreeingMatches(matches, m.truth);
+	EXPECT_GT(at_truth, 15u);
+	const Eigen::Vector2d centre(m.a.cols / 2.0, m.a.rows / 2.0);
+	Similarity2D turn(1, M_PI / 4, {0, 0});
+	turn.t = centre - turn.apply(centre);
+	EXPECT_LE(agreeingMatches(matches, turn.compose(m.truth)), 2u);
+	EXPECT_LE(agreeingMatches(matches, Similarity2D(1, 0, {60, 0}).compose(m.truth)), 2u);
+	// A transform at a scale no level pair matches (10x) takes none.
+	EXPECT_EQ(agreeingMatches(matches, Similarity2D(10, 0, {0, 0})), 0u);
+}
+
 TEST(MapAgreement, WallNormalsOfEachWallCell)
 {
 	// A horizontal wall (normal along y, 90°) and a vertical one (normal

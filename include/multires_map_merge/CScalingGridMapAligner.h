@@ -79,13 +79,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * (TCandidate::screened) instead of refined on every point. 0: off. */
 		int screen_points = 1500;
 		double screen_margin = 0.15;
-		/** The decided transform (after the decision, which it does not
-		 * change) is refit this many times to the best shifts of its moved
-		 * walls' tiles (bendBalanced in MapAgreement.h: both maps, one vote
-		 * per tile), and taken if its decision score is higher. Independent
+		/** Every candidate refined on every point is refit this many times
+		 * to the best shifts of its moved walls' tiles (bendBalanced in
+		 * MapAgreement.h: both maps, one vote per tile) before it is judged,
+		 * and the refit kept if its decision score is higher. Independent
 		 * SLAM maps bend: TsICP's trimmed fit follows the part that agrees
-		 * best and is off by cells over the rest. Not for refusals, nor
-		 * where the maps may be the same cells. 0: off. */
+		 * best and is off by cells over the rest. Chance fits gain from it
+		 * too: the decision is calibrated on refit candidates (negatives of
+		 * both map orders). Not where the maps may be the same cells. 0: off. */
 		int bend_refit_iterations = 3;
 		/** The decided transform is refined once more by TsICP on every
 		 * occupied cell of both maps (EdgePoints.h, occupiedPoints): edges
@@ -119,6 +120,14 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
 		double decision_evidence = 200;
+		/** The score gains this times min(m, decision_feature_cap) /
+		 * decision_feature_cap for the m feature matches (FeatureHypotheses.h,
+		 * agreeingMatches) that the transform takes onto each other: local
+		 * appearance (corners, door frames, clutter) agreeing where the walls
+		 * do, evidence the walls alone do not give between look-alike
+		 * buildings. 0: walls only. */
+		double decision_feature_weight = 0.1;
+		double decision_feature_cap = 10;
 		/** The best candidate merges on its walls only if they agree more
 		 * than chance by at least this (bent consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
@@ -130,18 +139,18 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * map lie near one running the same way (within 20°;
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.77;
+		double decision_min_wall_alignment = 0.75;
 		/** The best candidate merges on its walls only if at least this
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
 		 * bend smoothly, while a wrong alignment that lays walls near walls
 		 * fits each region by a shift of its own. */
-		double decision_min_shift_coherence = 0.25;
+		double decision_min_shift_coherence = 0.0;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 3.0;
+		double decision_runner_up_weight = 2.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.25;
@@ -151,7 +160,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 20.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.825;
+		double decision_threshold = 0.837;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
@@ -199,8 +208,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	/** One refined hypothesis and how it was judged. */
 	struct TCandidate
 	{
-		/** RANSAC start, TsICP result (cell coordinates); the decided
-		 * candidate's after the bend-balanced refit (bend_refit_iterations). */
+		/** RANSAC start, and TsICP's result after the bend-balanced refit
+		 * where that scored higher (bend_refit_iterations); cell coordinates. */
 		Similarity2D initial_cells, cells;
 		double overlap = 0, rmse_coarse_cells = 0;
 		/** Strict cell consistency (MapAgreement); NaN where the edge RMSE
@@ -218,6 +227,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Of adjacent tiles of the moved walls, the share whose best small
 		 * shifts agree (TwoWayShiftField::coherence). */
 		double shift_coherence = 0;
+		/** Feature matches this transform takes onto each other
+		 * (decision_feature_weight). */
+		size_t feature_agreement = 0;
 		/** The tolerant consistency with each tile of the moved walls shifted
 		 * as its neighbours fit best (TwoWayShiftField::bentConsistency): as
 		 * if a smooth bend were taken out. */
@@ -277,6 +289,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double wall_alignment = 0;  //!< TCandidate::wall_alignment of the chosen candidate
 		double shift_coherence = 0;  //!< TCandidate::shift_coherence of the chosen candidate
 		double bent_consistency = 0;  //!< TCandidate::bent_consistency of the chosen candidate
+		size_t feature_agreement = 0;  //!< TCandidate::feature_agreement of the chosen candidate
 		/** The chosen candidate's score, and where it is the pair's best-
 		 * scoring one, its best distinct rival's score and the decision value
 		 * (TCandidate; NaN otherwise). */

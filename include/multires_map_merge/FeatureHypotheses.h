@@ -65,6 +65,25 @@ bool sameExtraction(const FeatureParams& a, const FeatureParams& b);
 /** SIFT on every pyramid level of a class image. */
 std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const FeatureParams& p);
 
+/** The ratio-test matches of one pair of pyramid levels (full-resolution
+ * cell coordinates): `from` in the other map, `to` in the reference. */
+struct LevelMatches
+{
+	double level_scale = 1;  //!< the scale other → ref at which these levels' cells are of one size
+	double tolerance = 3;  //!< full-resolution reference cells (ransac_threshold at the reference level)
+	int ref_level = 0, other_level = 0;
+	std::vector<cv::Point2f> from, to;
+};
+/** Every level of one map matched against every level of the other. */
+std::vector<LevelMatches> featureMatches(
+	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other, const FeatureParams& p);
+
+/** The matches that `other_to_ref` takes to within their tolerance, over
+ * the level pairs whose cells are of one size at its scale (within √2):
+ * local appearance agreeing under a transform (the decision's evidence
+ * beside the walls). */
+size_t agreeingMatches(const std::vector<LevelMatches>& matches, const Similarity2D& other_to_ref);
+
 /** Similarity hypotheses other → ref, most RANSAC inliers first, near-
  * duplicates removed. `expected_scale` (from trusted metadata) drops the
  * hypotheses whose scale is more than `scale_tolerance` (relative) away. */
@@ -72,6 +91,9 @@ std::vector<Hypothesis> featureHypotheses(
 	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other,
 	const FeatureParams& p, std::optional<double> expected_scale = std::nullopt,
 	double scale_tolerance = 0.15);
+std::vector<Hypothesis> featureHypotheses(
+	const std::vector<LevelMatches>& matches, const FeatureParams& p,
+	std::optional<double> expected_scale = std::nullopt, double scale_tolerance = 0.15);
 
 /** RANSAC over point correspondences for a 4-DOF similarity (2-point
  * minimal sets; the model re-fitted on its inliers with Eigen::umeyama).
