@@ -144,7 +144,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
 		 * bend smoothly, while a wrong alignment that lays walls near walls
-		 * fits each region by a shift of its own. */
+		 * fits each region by a shift of its own. 0: no gate (the
+		 * calibrated default: README, "How the decision works"). */
 		double decision_min_shift_coherence = 0.0;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):

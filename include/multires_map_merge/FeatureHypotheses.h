@@ -91,6 +91,8 @@ std::vector<Hypothesis> featureHypotheses(
 	const std::vector<LevelFeatures>& ref, const std::vector<LevelFeatures>& other,
 	const FeatureParams& p, std::optional<double> expected_scale = std::nullopt,
 	double scale_tolerance = 0.15);
+/** The same from the matches (featureMatches), which the aligner also
+ * judges its candidates by. */
 std::vector<Hypothesis> featureHypotheses(
 	const std::vector<LevelMatches>& matches, const FeatureParams& p,
 	std::optional<double> expected_scale = std::nullopt, double scale_tolerance = 0.15);
