@@ -643,11 +643,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 				options.decision_feature_cap;
 		return j;
 	};
-	// The transform refit to where its regions fit best (bend_refit_iterations).
-	auto bendRefit = [&](Similarity2D t) {
+	// The transform refit to where its regions fit best (bend_refit_iterations),
+	// from its judgement's shift field (the first refit's: not computed again).
+	auto bendRefit = [&](const Judgement& judged_at, Similarity2D t) {
 		for (int i = 0; i < options.bend_refit_iterations && t.isFinite() && t.scale > 0; ++i)
 			t = bendBalanced(
-				twoWayShiftField(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance), t);
+				i == 0 ? judged_at.bends
+					   : twoWayShiftField(ref_edges, ref_field, other_edges, other_field, t, options.verify_tolerance),
+				t);
 		return t;
 	};
 	Eigen::Vector2d other_centroid(0, 0);
@@ -786,7 +789,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		// Refit to where its regions fit best (bend_refit_iterations).
 		if (options.bend_refit_iterations > 0 && !may_be_exact)
 		{
-			const Similarity2D balanced = bendRefit(r.transform);
+			const Similarity2D balanced = bendRefit(judgement, r.transform);
 			if (balanced.isFinite() && balanced.scale > 0 && scaleAsStated(balanced))
 				if (Judgement j = decisionScore(balanced, kJudgedPoints, true); j.score > judgement.score)
 					judgement = std::move(j), r.transform = balanced;
