@@ -9,7 +9,7 @@ TOP_FITS overall; --all: every combination tried), then the ini keys.
 The CSVs come from the benchmark (bench/multires_bench writes candidates.csv:
 every refined hypothesis of every pair, its features and whether it was right
 against the truth). Only rows marked calibration=1 are used: Halmstad E5 and
-HIH sensor pairs (positives), cross-site pairs with an E5 map, the CARMEN
+HIH sensor pairs (positives, both orders in data made since 92b821e), cross-site pairs with an E5 map, the CARMEN
 different-building and disjoint-part pairs at both resolution orders, the
 first 15 % of a CARMEN run against a whole other building (little seen: the
 evidence discount decides), and every E5 and HIH map against its own mirror
@@ -260,8 +260,10 @@ def main():
                          f"highest wrong {max(wrong):.3f}, threshold {threshold:.3f}, "
                          f"merged right {merged_right}/{len(positives)}, live {live_right}/{len(live)}"))
             if best is None or rank > best[0]:
+                # Per file, and in the report's order (REF the later map).
                 per_file = collections.Counter(
-                    key[3] for key in positives if key in tops and tops[key]["right"] and values[key] >= threshold)
+                    (key[3], key[1] > key[2]) for key in positives
+                    if key in tops and tops[key]["right"] and values[key] >= threshold)
                 best = (rank, w, e, fw, fcap, k, floor, lead, align, coh, ds, threshold, merged_right, live_right,
                         per_file)
     if show_all:
@@ -286,7 +288,9 @@ def main():
           f"{live_right}/{len(live)}")
     for path in paths:
         n = sum(1 for key in positives if key[3] == path)
-        print(f"#   {path}: {per_file[path]}/{n} positive pairs merged right")
+        n_later = sum(1 for key in positives if key[3] == path and key[1] > key[2])
+        print(f"#   {path}: {per_file[(path, True)] + per_file[(path, False)]}/{n} positive pairs merged right, "
+              f"{per_file[(path, True)]}/{n_later} with the later map as REF (the report's order)")
 
 
 if __name__ == "__main__":
