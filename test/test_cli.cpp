@@ -147,6 +147,8 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --config " + d + "/none.ini", "none.ini': no such config"},
 			 Bad{d + "/ok.gridmap.gz", "OTHER"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --bogus", "bogus"},
+			 // A file option followed by another option: no file named "--png".
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --json --png " + d + "/x.png", "--json needs a file name, not '--png'"},
 		 })
 	{
 		SCOPED_TRACE(b.args);
@@ -154,4 +156,6 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 		EXPECT_EQ(r.exit_code, 2) << r.output;
 		EXPECT_NE(r.output.find(b.words), std::string::npos) << r.output;
 	}
+	EXPECT_FALSE(fs::exists("--png"));
+	EXPECT_FALSE(fs::exists(d + "/x.png"));
 }
