@@ -6,6 +6,7 @@
 // A child mode aligns one scaling case in a fresh process, so its peak
 // memory is its own (maps + aligner).
 
+#include <mrpt/config/CConfigFile.h>
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/FleetMerge.h>
@@ -1064,6 +1065,10 @@ int main(int argc, char** argv)
 	TCLAP::SwitchArg calibration_arg(
 		"", "calibration-data", "only the calibration data (Halmstad E5/HIH, E5 cross-site and CARMEN negatives) "
 		"into candidates.csv, for scripts/calibrate_decision.py", cmd);
+	TCLAP::ValueArg<std::string> config_arg(
+		"", "config",
+		"aligner parameters, section [aligner] of an MRPT ini file (calibration data made with other defaults)",
+		false, "", "FILE.ini", cmd);
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
 	TCLAP::SwitchArg live_pairs_arg(
 		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
@@ -1108,6 +1113,12 @@ int main(int argc, char** argv)
 	try
 	{
 
+		if (config_arg.isSet())
+		{
+			if (!fs::is_regular_file(config_arg.getValue()))
+				throw std::runtime_error("'" + config_arg.getValue() + "': no such config file");
+			g_aligner_options.loadFromConfigFile(mrpt::config::CConfigFile(config_arg.getValue()), "aligner");
+		}
 		const bool quick = quick_arg.getValue();
 		const std::string out = out_arg.getValue();
 		fs::create_directories(out);
