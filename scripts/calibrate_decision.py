@@ -9,7 +9,7 @@ TOP_FITS overall; --all: every combination tried), then the ini keys.
 The CSVs come from the benchmark (bench/multires_bench writes candidates.csv:
 every refined hypothesis of every pair, its features and whether it was right
 against the truth). Only rows marked calibration=1 are used: Halmstad E5 and
-HIH sensor pairs (positives, both orders in data made since 92b821e), cross-site pairs with an E5 map, the CARMEN
+HIH sensor pairs (positives, both orders in data made since a145d9e), cross-site pairs with an E5 map, the CARMEN
 different-building and disjoint-part pairs at both resolution orders, the
 first 15 % of a CARMEN run against a whole other building (little seen: the
 evidence discount decides), and every E5 and HIH map against its own mirror
