@@ -179,18 +179,16 @@ std::vector<Hypothesis> featureHypotheses(
 	std::vector<Hypothesis> found;
 	for (const LevelMatches& lm : matches)
 	{
-		std::vector<cv::Point2f> from = lm.from, to = lm.to;
-		const double thr = lm.tolerance;
+		std::vector<cv::Point2f> from = lm.from, to = lm.to;  // re-run on what each model leaves
 		// Levels of equal cell size match best: this pair looks for a
 		// scale near other level / ref level, within a factor of 2 (the
 		// neighbouring level pairs cover the rest).
-		const double level_scale = lm.level_scale;
 		for (int k = 0; k < p.hypotheses_per_level_pair; ++k)
 		{
 			std::vector<uchar> mask;
 			auto s = ransacSimilarity(
-				from, to, thr, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask, level_scale / 2,
-				level_scale * 2);
+				from, to, lm.tolerance, p.ransac_iterations, p.ransac_confidence, p.min_inliers, mask,
+				lm.level_scale / 2, lm.level_scale * 2);
 			if (!s) break;
 			found.push_back({*s, cv::countNonZero(mask), static_cast<int>(from.size()), lm.ref_level, lm.other_level});
 			// Re-run on the matches this model did not explain: a second

@@ -27,6 +27,10 @@ namespace
 {
 constexpr int kMerged = 0, kNotMerged = 1, kBadInput = 2;
 
+/** A value a file option may take: not empty, not an option (TCLAP gives a
+ * file option the next word even if it is one). */
+bool isFileName(const std::string& value) { return !value.empty() && value[0] != '-'; }
+
 struct UsageError : std::runtime_error
 {
 	using std::runtime_error::runtime_error;
@@ -185,10 +189,9 @@ int main(int argc, char** argv)
 		cmd.parse(args);
 		for (const auto& m : maps_arg.getValue())  // TCLAP takes unknown flags as positionals
 			if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
-		// TCLAP gives a file option the next word even if it is an option
-		// ("--json --png x.png" wrote the JSON to a file named "--png").
+		// "--json --png x.png" wrote the JSON to a file named "--png".
 		for (const auto* a : {&json_arg, &out_arg, &png_arg, &config_arg, &bag_arg})
-			if (a->isSet() && (a->getValue().empty() || a->getValue()[0] == '-'))
+			if (a->isSet() && !isFileName(a->getValue()))
 				throw UsageError("--" + a->getName() + " needs a file name, not '" + a->getValue() + "'");
 		const bool bag_mode = bag_arg.isSet();
 		if (bag_mode && !maps_arg.getValue().empty())
@@ -289,7 +292,7 @@ int main(int argc, char** argv)
 		std::cerr << "gridmap-merge: " << e.what() << "\n";
 		r.success = false;
 		r.message = e.what();
-		if (json_arg.isSet() && !json_arg.getValue().empty() && json_arg.getValue()[0] != '-')
+		if (json_arg.isSet() && isFileName(json_arg.getValue()))
 		{
 			try
 			{
