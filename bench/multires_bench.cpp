@@ -32,6 +32,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -149,20 +150,27 @@ CScalingGridMapAligner benchAligner()
 	return a;
 }
 
+bool candidatesWanted() { return g_candidates.is_open(); }
+
+/** The transform a candidate would be reported with, if decided on. */
+using ReportedOf = std::function<Similarity2D(const CScalingGridMapAligner::TCandidate&)>;
+const Similarity2D& asRefined(const CScalingGridMapAligner::TCandidate& c) { return c.cells; }
+
 /** `error_of(cells)` is the candidate's error (pixels or coarse cells) and
- * whether that is right; for negatives every candidate is wrong. */
+ * whether that is right, judged on `reported_of(candidate)`; for negatives
+ * every candidate is wrong. */
 template <class ErrorOf>
 void writeCandidates(
 	const std::string& site, const std::string& ref, const std::string& other, bool positive, bool calibration,
-	const CScalingGridMapAligner::TReturnInfo& r, ErrorOf error_of)
+	const CScalingGridMapAligner::TReturnInfo& r, ErrorOf error_of, const ReportedOf& reported_of = asRefined)
 {
-	if (!g_candidates.is_open()) return;
+	if (!candidatesWanted()) return;
 	for (size_t i = 0; i < r.candidates.size(); ++i)
 	{
 		const auto& c = r.candidates[i];
 		// A mirrored candidate (mirror_check) is a transform of the flipped map: never right.
 		const bool judge = positive && !c.mirrored;
-		const auto [err, right] = judge ? error_of(c.cells) : std::pair<double, bool>{NAN, false};
+		const auto [err, right] = judge ? error_of(reported_of(c)) : std::pair<double, bool>{NAN, false};
 		const auto init = judge ? error_of(c.initial_cells) : std::pair<double, bool>{NAN, false};
 		g_candidates << site << "," << ref << "," << other << "," << positive << "," << calibration << "," << i << ","
 					 << right << "," << err << "," << c.cells.scale << "," << c.overlap << "," << c.rmse_coarse_cells
@@ -937,9 +945,18 @@ HalmstadRun runHalmstadPair(
 			fs::canonical("/proc/self/exe"), data.yaml(ref, dir), data.yaml(other, dir), mrpt_limit_s);
 		if (truth && run.mrpt.aligned) run.mrpt_right = judge(run.mrpt.metric, *truth, other_map, ref_rows).right;
 	}
-	writeCandidates(run.site, ref, other, run.positive, run.calibration, r, [&](const Similarity2D& cells) {
+	// Each candidate judged as it would be reported (the aligner's finish for
+	// maps that bend, finishBent): what a user gets if the decision picks it.
+	CScalingGridMapAligner::PreparedMapPtr ref_prepared, other_prepared;
+	if (truth && candidatesWanted())
+		ref_prepared = benchAligner().prepare(ref_map.grid), other_prepared = benchAligner().prepare(other_map.grid);
+	const auto error_of = [&](const Similarity2D& cells) {
 		const HalmstadOutcome o = judge(candidateMetric(ref_map, cells, other_map), *truth, other_map, ref_rows);
 		return std::pair<double, bool>{o.mean_displacement_px, o.right};
+	};
+	writeCandidates(run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
+		return ref_prepared ? benchAligner().finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells)
+							: c.cells;
 	});
 	std::cout << "halmstad " << ref << " <- " << other << ": "
 			  << (run.positive ? (run.merged ? (run.outcome.right ? "merged right" : "MERGED WRONG") : "refused")

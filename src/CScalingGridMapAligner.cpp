@@ -56,6 +56,7 @@ void CScalingGridMapAligner::TConfigParams::loadFromConfigFile(
 	MRPT_LOAD_CONFIG_VAR(icp_finish_on_occupied, bool, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_max_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(finish_lattice_step, double, c, s);
+	MRPT_LOAD_CONFIG_VAR(finish_bent_lambda, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_tolerance, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_shift, double, c, s);
 	MRPT_LOAD_CONFIG_VAR(verify_turn_deg, double, c, s);
@@ -107,6 +108,7 @@ std::string CScalingGridMapAligner::TConfigParams::invalidReason() const
 	in("finish_max_shift", finish_max_shift, 0, 100);
 	if (finish_lattice_step != 0)  // 0 turns it off; finer steps only cost time
 		in("finish_lattice_step", finish_lattice_step, 0.01, 0.5);
+	in("finish_bent_lambda", finish_bent_lambda, 0, 100);
 	in("verify_tolerance", verify_tolerance, 0.5, 50);
 	in("verify_shift", verify_shift, 1, 1000);
 	in("verify_turn_deg", verify_turn_deg, 1, 90);
@@ -154,6 +156,7 @@ void CScalingGridMapAligner::TConfigParams::saveToConfigFile(
 	MRPT_SAVE_CONFIG_VAR_COMMENT(icp_finish_on_occupied, "Finish the decided transform by TsICP on all occupied cells");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_max_shift, "A finish moving any point further is not taken [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_lattice_step, "Step of the finish's sub-cell shift on the coarser lattice (0: off) [coarse cells]");
+	MRPT_SAVE_CONFIG_VAR_COMMENT(finish_bent_lambda, "Maps that bend: the decided transform is refit with this overlap preference (0: off)");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_tolerance, "Walls this close agree [cells of the coarser map]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_shift, "Chance: the transform shifted by this much [coarse cells]");
 	MRPT_SAVE_CONFIG_VAR_COMMENT(verify_turn_deg, "Chance: the transform turned by this much [deg]");
@@ -525,6 +528,28 @@ Similarity2D CScalingGridMapAligner::finishOnOccupied(
 	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells) const
 {
 	return finishOnOccupiedCells(ref, other, cells, options.icpParams(), options.latticeParams());
+}
+
+Similarity2D CScalingGridMapAligner::finishBent(
+	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells) const
+{
+	// Maps whose edges may coincide are the exact finish's (finishOnOccupied).
+	if (options.finish_bent_lambda <= 0 || !(rmse_coarse_cells >= kExactMaxRmse) || other.edges.empty() || !ref.edge_tree || !other.edge_tree) return cells;
+	TsICPParams wide = options.icpParams();
+	wide.lambda = options.finish_bent_lambda;
+	const Similarity2D refit = refineFromTheInside(ref, other, cells, wide).transform;
+	Eigen::Vector2d other_centroid(0, 0);
+	for (const auto& p : other.edges) other_centroid += p;
+	other_centroid /= double(other.edges.size());
+	// The decision judged `cells`: the refit moves it within its bends, never
+	// to a rival placement.
+	if (refit.isFinite() && refit.scale > 0 &&
+		samePlacement(
+			refit, refit.apply(other_centroid), cells, cells.apply(other_centroid), options.distinct_shift,
+			options.verify_turn_deg, std::log(1.1)))
+		return refit;
+	MRPT_LOG_DEBUG_STREAM("refit over the whole overlap not taken: it places the other map elsewhere");
+	return cells;
 }
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
@@ -1058,6 +1083,14 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 			info.cells = finished;
 		else
 			MRPT_LOG_DEBUG_STREAM("finish on occupied cells not taken: it moves a wall by " << shift / coarse << " coarse cells");
+		info.stage_seconds["finish"] = stage.Tac();
+	}
+	// Maps that bend (the exact finish did not apply): the pose balanced over
+	// the whole overlap (finishBent).
+	else if (!mirror_pass)
+	{
+		stage.Tic();
+		info.cells = finishBent(ref, other, info.cells, info.trimmed_rmse_coarse_cells);
 		info.stage_seconds["finish"] = stage.Tac();
 	}
 	info.metric = ref.cell_to_metric.compose(info.cells).compose(other.cell_to_metric.inverse());
