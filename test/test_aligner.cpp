@@ -351,10 +351,10 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	// the confidence scale) above its value on the calibration machine;
 	// another machine's hypotheses move it by a few hundredths.
 	EXPECT_LT(d.confidence, 0.35) << d.message;
-	// At a threshold its value passes (its score has no rival), only the
-	// gate can refuse it.
+	// At a threshold its value passes, only the gate can refuse it: the
+	// threshold is set to the value the gated run reports (gates change no
+	// value).
 	CScalingGridMapAligner gated, ungated;
-	gated.options.decision_threshold = ungated.options.decision_threshold = 0.3;
 	gated.options.decision_min_lead = 0.04;
 	ungated.options.decision_min_lead = 0;
 	// Its walls near the other map's also run alike too rarely, and its
@@ -362,7 +362,10 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	// shift-coherence gates refuse it as well): off here, to see the lead gate.
 	gated.options.decision_min_wall_alignment = ungated.options.decision_min_wall_alignment = 0;
 	gated.options.decision_min_shift_coherence = ungated.options.decision_min_shift_coherence = 0;
-	const auto r = gated.alignScaled(ref, other), u = ungated.alignScaled(ref, other);
+	const auto r = gated.alignScaled(ref, other);
+	ASSERT_GE(r.decision_value, 0) << "a threshold must be positive; " << r.message;
+	ungated.options.decision_threshold = r.decision_value;
+	const auto u = ungated.alignScaled(ref, other);
 	EXPECT_FALSE(r.success) << r.message;
 	EXPECT_LT(r.bent_consistency - r.chance_consistency, gated.options.decision_min_lead);
 	EXPECT_NE(r.message.find("no more than chance"), std::string::npos) << r.message;
