@@ -1087,7 +1087,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	}
 	// Maps that bend (the exact finish did not apply): the pose balanced over
 	// the whole overlap (finishBent).
-	else if (!mirror_pass)
+	else if (!mirror_pass && options.finish_bent_lambda > 0 && info.trimmed_rmse_coarse_cells >= kExactMaxRmse)
 	{
 		stage.Tic();
 		info.cells = finishBent(ref, other, info.cells, info.trimmed_rmse_coarse_cells);
