@@ -126,44 +126,41 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		// partial maps of two buildings: without them a fit placed intel's robot
 		// in fr079), made by this code with these defaults: no wrong calibration
 		// candidate passes, with a margin (README, "How the decision works").
-		double decision_chance_weight = 0.5;
+		double decision_chance_weight = 1.0;
 		/** Evidence discount: the score loses √(decision_evidence / n) for n
 		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 200;
+		double decision_evidence = 400;
 		/** The score gains this times min(m, decision_feature_cap) /
 		 * decision_feature_cap for the m feature matches (FeatureHypotheses.h,
 		 * agreeingMatches) that the transform takes onto each other: local
 		 * appearance (corners, door frames, clutter) agreeing where the walls
 		 * do, evidence the walls alone do not give between look-alike
 		 * buildings. 0: walls only. */
-		double decision_feature_weight = 0.1;
+		double decision_feature_weight = 0.2;
 		double decision_feature_cap = 10;
 		/** The best candidate merges on its walls only if they agree more
 		 * than chance by at least this (bent consistency − chance): two
 		 * buildings whose walls agree about as well anywhere (a small map
 		 * against a large one of another building) prove nothing, however
-		 * few rivals they have. 0: no gate beyond B ≥ C (the calibrated
-		 * default: with runner-up weight 3 the threshold refuses such pairs;
-		 * README, "How the decision works"). */
-		double decision_min_lead = 0.0;
+		 * few rivals they have. 0: no gate beyond B ≥ C. */
+		double decision_min_lead = 0.04;
 		/** The best candidate merges on its walls only if at least this
 		 * share of its wall points lying near a directed wall of the other
 		 * map lie near one running the same way (within 20°;
 		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
 		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.72;
+		double decision_min_wall_alignment = 0.7;
 		/** The best candidate merges on its walls only if at least this
 		 * share of adjacent tiles of its moved walls fit best after about the
 		 * same small shift (TwoWayShiftField::coherence): independent maps
 		 * bend smoothly, while a wrong alignment that lays walls near walls
-		 * fits each region by a shift of its own. 0: no gate (the
-		 * calibrated default: README, "How the decision works"). */
-		double decision_min_shift_coherence = 0.0;
+		 * fits each region by a shift of its own. 0: no gate. */
+		double decision_min_shift_coherence = 0.25;
 		/** The pair's decision value: the best-scoring candidate's score plus
 		 * this times its lead over the best distinct rival (distinct_shift):
 		 * the right alignment of one building stands out, a chance fit of
 		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 3.0;
+		double decision_runner_up_weight = 1.0;
 		/** A rival scoring below this counts as this: with no rival, the lead
 		 * is measured from it. */
 		double decision_runner_up_floor = 0.25;
@@ -177,7 +174,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double distinct_shift = 40.0;
 		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
 		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 1.054;
+		double decision_threshold = 0.664;
 		/** Below this the result is "not merged". */
 		double min_confidence = 0.5;
 		/** Trust the stated resolutions as a prior on the scale. */
