@@ -534,7 +534,9 @@ Similarity2D CScalingGridMapAligner::finishBent(
 	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells) const
 {
 	// Maps whose edges may coincide are the exact finish's (finishOnOccupied).
-	if (options.finish_bent_lambda <= 0 || !(rmse_coarse_cells >= kExactMaxRmse) || other.edges.empty() || !ref.edge_tree || !other.edge_tree) return cells;
+	if (options.finish_bent_lambda <= 0 || !(rmse_coarse_cells >= kExactMaxRmse) || other.edges.empty() ||
+		!ref.edge_tree || !other.edge_tree)
+		return cells;
 	TsICPParams wide = options.icpParams();
 	wide.lambda = options.finish_bent_lambda;
 	const Similarity2D refit = refineFromTheInside(ref, other, cells, wide).transform;
