@@ -134,10 +134,16 @@ std::shared_ptr<const GridInFrame> mapServerFile(const std::string& log, bool re
 /** Every refined hypothesis of every pair, with its features and whether it
  * was right: what scripts/calibrate_decision.py fits the decision on. */
 std::ofstream g_candidates;
-const char* kCandidateHeader =
-	"site,ref,other,positive,calibration,index,right,error,scale,overlap,rmse_coarse,consistency,support,"
-	"judged,tolerant_consistency,chance_consistency,score,confidence,initial_error,screened,yaw_deg,centre_x,"
-	"centre_y,mirrored,chance_support,wall_alignment,shift_coherence,bent_consistency,feature_agreement\n";
+/** The columns of candidates.csv: the pair, the truth, the placement, then
+ * every evidence field (Decision.h's one list). */
+std::string candidateHeader()
+{
+	std::string header =
+		"site,ref,other,positive,calibration,index,right,error,initial_error,scale,yaw_deg,centre_x,centre_y,overlap,"
+		"rmse_coarse,consistency,screened,mirrored,score,confidence";
+	for (const auto& f : evidenceFields()) header += std::string(",") + f.name;
+	return header + "\n";
+}
 
 /** The options every aligner of the benchmark runs with: the defaults, except
  * for --calibration-data, which refines every hypothesis and always searches
@@ -173,13 +179,12 @@ void writeCandidates(
 		const auto [err, right] = judge ? error_of(reported_of(c)) : std::pair<double, bool>{NAN, false};
 		const auto init = judge ? error_of(c.initial_cells) : std::pair<double, bool>{NAN, false};
 		g_candidates << site << "," << ref << "," << other << "," << positive << "," << calibration << "," << i << ","
-					 << right << "," << err << "," << c.cells.scale << "," << c.overlap << "," << c.rmse_coarse_cells
-					 << "," << c.consistency << "," << c.support << "," << c.judged_points << ","
-					 << c.tolerant_consistency << "," << c.chance_consistency << "," << c.score << ","
-					 << c.confidence << "," << init.first << "," << c.screened << "," << c.cells.yaw * 180 / M_PI << ","
-					 << c.other_centre.x() << "," << c.other_centre.y() << "," << c.mirrored << "," << c.chance_support << ","
-					 << c.wall_alignment << "," << c.shift_coherence << "," << c.bent_consistency << ","
-					 << c.feature_agreement << "\n";
+					 << right << "," << err << "," << init.first << "," << c.cells.scale << ","
+					 << c.cells.yaw * 180 / M_PI << "," << c.other_centre.x() << "," << c.other_centre.y() << ","
+					 << c.overlap << "," << c.rmse_coarse_cells << "," << c.consistency << "," << c.screened << ","
+					 << c.mirrored << "," << c.score << "," << c.confidence;
+		for (const auto& f : evidenceFields()) g_candidates << "," << c.evidence.*f.member;
+		g_candidates << "\n";
 	}
 }
 
@@ -269,7 +274,8 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 		const Similarity2D truth_cells = ref.cellToMapFrame().inverse().compose(truth).compose(other.cellToMapFrame());
 		// The aligner's last refinement, started at the truth.
 		const Similarity2D at_truth = aligner.options.icp_finish_on_occupied
-			? aligner.finishOnOccupied(*aligner.prepare(ref.grid), *aligner.prepare(other.grid), truth_cells)
+			? finishOnOccupied(*aligner.prepare(ref.grid), *aligner.prepare(other.grid), truth_cells,
+							   aligner.options.icpParams(), aligner.options.latticeParams())
 			: runTsICP(edgePoints(toClassImage(ref.grid)), edgePoints(toClassImage(other.grid)), truth_cells,
 					   aligner.options.icpParams()).transform;
 		p.floor_rmse = pointRmse(ref.cellToMapFrame().compose(at_truth).compose(other.cellToMapFrame().inverse()),
@@ -955,8 +961,10 @@ HalmstadRun runHalmstadPair(
 		return std::pair<double, bool>{o.mean_displacement_px, o.right};
 	};
 	writeCandidates(run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
-		return ref_prepared ? benchAligner().finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells)
-							: c.cells;
+		const auto& o = g_aligner_options;
+		return ref_prepared
+			? finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells, o.finishParams(), o.decision)
+			: c.cells;
 	});
 	std::cout << "halmstad " << ref << " <- " << other << ": "
 			  << (run.positive ? (run.merged ? (run.outcome.right ? "merged right" : "MERGED WRONG") : "refused")
@@ -1140,7 +1148,7 @@ int main(int argc, char** argv)
 		const std::string out = out_arg.getValue();
 		fs::create_directories(out);
 		g_candidates.open(out + "/candidates.csv");
-		g_candidates << kCandidateHeader;
+		g_candidates << candidateHeader();
 		if (calibration_arg.getValue())
 		{
 			// Every hypothesis refined, the structure always searched: the

@@ -99,7 +99,7 @@ int main(int argc, char** argv)
 				  "config_section"});
 		// m-explore's threshold, default 1.0, maps onto our confidence at
 		// half: 1.0 → 0.5, the calibrated default; min_confidence wins if set.
-		if (!pnh.hasParam("min_confidence")) params.aligner.min_confidence = 0.5 * s.estimation_confidence;
+		if (!pnh.hasParam("min_confidence")) params.aligner.decision.min_confidence = 0.5 * s.estimation_confidence;
 		params.output_resolution = s.output_resolution;
 		params.known_init_poses = s.known_init_poses;
 		params.estimation_budget_s = ros1::defaultEstimationBudget(s.estimation_rate);

@@ -16,6 +16,14 @@ nlohmann::ordered_json transformJson(const Similarity2D& t)
 {
 	return {{"x", num(t.t.x())}, {"y", num(t.t.y())}, {"yaw", num(t.yaw)}, {"scale", num(t.scale)}};
 }
+/** Every evidence field (Decision.h's one list), counts as integers. */
+nlohmann::ordered_json evidenceJson(const Evidence& e)
+{
+	nlohmann::ordered_json j = nlohmann::ordered_json::object();
+	for (const auto& f : evidenceFields())
+		j[f.name] = f.count ? nlohmann::ordered_json(std::llround(e.*f.member)) : num(e.*f.member);
+	return j;
+}
 }  // namespace
 
 std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_s)
@@ -31,12 +39,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"overlap", num(r.overlap)},
 		{"objective", num(r.objective)},
 		{"inliers", r.ransac_inliers},
-		{"consistency", num(r.consistency)},
-		{"chance_consistency", num(r.chance_consistency)},
-		{"wall_alignment", num(r.wall_alignment)},
-		{"shift_coherence", num(r.shift_coherence)},
-		{"feature_agreement", r.feature_agreement},
-		{"bent_consistency", num(r.bent_consistency)},
+		{"evidence", evidenceJson(r.evidence)},
 		{"score", num(r.score)},
 		{"runner_up_score", num(r.runner_up_score)},
 		{"decision_value", num(r.decision_value)},

@@ -123,7 +123,7 @@ TEST(Search, HypothesesLandingOnAnExactCandidateAreNotRefinedAgain)
 	every.options.exhaustive_search = true;
 	// A threshold no score reaches alone: the search does not stop on a
 	// score (where a calibration puts it), only on the cells.
-	fast.options.decision_threshold = every.options.decision_threshold = 5;
+	fast.options.decision.threshold = every.options.decision.threshold = 5;
 	size_t landed = 0;
 	for (const Case c : {Case{"fr079", 0.02, 0.02, 0, 0.6}, Case{"fr079", 0.04, 0.06, 33, 0.6}})
 	{
@@ -139,7 +139,7 @@ TEST(Search, HypothesesLandingOnAnExactCandidateAreNotRefinedAgain)
 			++landed;
 			EXPECT_TRUE(c.screened);
 			const bool near_exact = std::any_of(a.candidates.begin(), a.candidates.begin() + i, [&](const auto& e) {
-				return !e.screened && e.exact_confidence >= fast.options.min_confidence && !fast.areRivals(e, c);
+				return !e.screened && e.evidence.exact_confidence >= fast.options.decision.min_confidence && !fast.options.decision.areRivals(e.placement(), c.placement());
 			});
 			EXPECT_TRUE(near_exact) << "candidate " << i << " landed on no exact candidate found before it";
 		}
@@ -249,7 +249,7 @@ TEST(Decision, MapsOfDifferentBuildingsAreNotMerged)
 	for (const auto& [a, b] : {std::pair{&malaga, &loc}, std::pair{&loc, &malaga}})
 	{
 		const auto r = aligner.alignScaled(*a, *b);
-		EXPECT_FALSE(r.success) << "confidence " << r.confidence << " consistency " << r.consistency;
+		EXPECT_FALSE(r.success) << "confidence " << r.confidence << " tolerant consistency " << r.evidence.tolerant_consistency;
 		EXPECT_FALSE(r.message.empty());
 	}
 }
@@ -311,7 +311,7 @@ TEST(Config, IniRoundTripAndOverride)
 	partial.write("aligner", "min_confidence", 0.8);
 	CScalingGridMapAligner::TConfigParams c;
 	c.loadFromConfigFile(partial, "aligner");
-	EXPECT_DOUBLE_EQ(c.min_confidence, 0.8);
+	EXPECT_DOUBLE_EQ(c.decision.min_confidence, 0.8);
 	EXPECT_DOUBLE_EQ(c.xi_min, 0.35);
 }
 }  // namespace
@@ -355,19 +355,19 @@ TEST(Decision, WallsNoBetterThanChanceAreNotMerged)
 	// threshold is set to the value the gated run reports (gates change no
 	// value).
 	CScalingGridMapAligner gated, ungated;
-	gated.options.decision_min_lead = 0.04;
-	ungated.options.decision_min_lead = 0;
+	gated.options.decision.min_lead = 0.04;
+	ungated.options.decision.min_lead = 0;
 	// Its walls near the other map's also run alike too rarely, and its
 	// regions fit by shifts of their own (the wall-alignment and
 	// shift-coherence gates refuse it as well): off here, to see the lead gate.
-	gated.options.decision_min_wall_alignment = ungated.options.decision_min_wall_alignment = 0;
-	gated.options.decision_min_shift_coherence = ungated.options.decision_min_shift_coherence = 0;
+	gated.options.decision.min_wall_alignment = ungated.options.decision.min_wall_alignment = 0;
+	gated.options.decision.min_shift_coherence = ungated.options.decision.min_shift_coherence = 0;
 	const auto r = gated.alignScaled(ref, other);
 	ASSERT_GE(r.decision_value, 0) << "a threshold must be positive; " << r.message;
-	ungated.options.decision_threshold = r.decision_value;
+	ungated.options.decision.threshold = r.decision_value;
 	const auto u = ungated.alignScaled(ref, other);
 	EXPECT_FALSE(r.success) << r.message;
-	EXPECT_LT(r.bent_consistency - r.chance_consistency, gated.options.decision_min_lead);
+	EXPECT_LT(r.evidence.bent_consistency - r.evidence.chance_consistency, gated.options.decision.min_lead);
 	EXPECT_NE(r.message.find("no more than chance"), std::string::npos) << r.message;
 	// What the gate refuses: the same candidate, merged on its lead alone.
 	EXPECT_TRUE(u.success) << u.message;

@@ -113,7 +113,7 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 	// (a score alone reaching it merges whatever comes).
 	const CScalingGridMapAligner aligner;
 	const auto& o = aligner.options;
-	ASSERT_GT(o.decision_runner_up_weight, 0);
+	ASSERT_GT(o.decision.runner_up_weight, 0);
 	for (const auto& [ref, other] : {std::pair{"E5_11", "E5_02"}, std::pair{"E5_12", "E5_01"}})
 	{
 		SCOPED_TRACE(std::string(ref) + " <- " + other);
@@ -125,23 +125,24 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		for (const auto& c : cands)
 			if (!c.screened && !c.mirrored && (!best || c.score > best->score)) best = &c;
 		ASSERT_NE(best, nullptr);
-		double rival = o.decision_runner_up_floor;
+		double rival = o.decision.runner_up_floor;
 		size_t rivals = 0;
 		for (const auto& c : cands)
 		{
 			if (&c == best) continue;
 			// The mirrored map's candidates (mirror_check) rival every candidate.
-			if (!c.screened && (c.mirrored || aligner.areRivals(*best, c))) rival = std::max(rival, c.score), ++rivals;
+			if (!c.screened && (c.mirrored || o.decision.areRivals(best->placement(), c.placement()))) rival = std::max(rival, c.score), ++rivals;
 			EXPECT_TRUE(std::isnan(c.decision_value)) << "only the best-scoring candidate is decided on";
 		}
 		// Pairs chosen for a rival above the floor (most rivals score below it).
-		EXPECT_GT(rival, o.decision_runner_up_floor) << rivals << " rivals";
+		EXPECT_GT(rival, o.decision.runner_up_floor) << rivals << " rivals";
 		EXPECT_DOUBLE_EQ(best->runner_up_score, rival);
-		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision_runner_up_weight * (best->score - rival));
-		const bool walls_may_merge = o.leadsChance(best->bent_consistency, best->chance_consistency) &&
-			o.wallsRunAlike(best->wall_alignment) && o.shiftsCohere(best->shift_coherence);
-		EXPECT_EQ(walls_may_merge, aligner.mayMergeOnWalls(*best));
-		EXPECT_EQ(res.success, walls_may_merge && best->decision_value >= o.decision_threshold);
+		EXPECT_DOUBLE_EQ(best->decision_value, best->score + o.decision.runner_up_weight * (best->score - rival));
+		const Evidence& e = best->evidence;
+		const bool walls_may_merge = e.bent_consistency - e.chance_consistency >= o.decision.min_lead &&
+			e.wall_alignment >= o.decision.min_wall_alignment && e.shift_coherence >= o.decision.min_shift_coherence;
+		EXPECT_EQ(walls_may_merge, o.decision.mayMergeOnWalls(e));
+		EXPECT_EQ(res.success, walls_may_merge && best->decision_value >= o.decision.threshold);
 		if (res.success)
 		{
 			EXPECT_DOUBLE_EQ(res.decision_value, best->decision_value);
@@ -149,11 +150,11 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 		else
 		{
 			EXPECT_NE(res.message.find("best rival"), std::string::npos) << res.message;
-			if (!o.wallsRunAlike(best->wall_alignment))
+			if (!o.decision.wallsRunAlike(e))
 			{
 				EXPECT_NE(res.message.find("running alike"), std::string::npos) << res.message;
 			}
-			if (!o.shiftsCohere(best->shift_coherence))
+			if (!o.decision.shiftsCohere(e))
 			{
 				EXPECT_NE(res.message.find("shifts alike"), std::string::npos) << res.message;
 			}
@@ -194,7 +195,7 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 	// better mirrored, refuses, and says why.
 	const GridInFrame original = loadGridMap(halmstad()->yaml(map, dir()));
 	CScalingGridMapAligner unchecked, checked;
-	unchecked.options.decision_min_wall_alignment = checked.options.decision_min_wall_alignment = 0;
+	unchecked.options.decision.min_wall_alignment = checked.options.decision.min_wall_alignment = 0;
 	unchecked.options.mirror_check = false;
 	ASSERT_TRUE(checked.options.mirror_check);
 	const auto without = unchecked.alignScaled(original, mirrored);
@@ -233,7 +234,7 @@ TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
 		// both right against the annotation.
 		EXPECT_NEAR(a.confidence, b.confidence, 0.05);
 		const double w = o.grid.getXMax() - o.grid.getXMin(), h = o.grid.getYMax() - o.grid.getYMin();
-		const double same_placement_m = screened.options.distinct_shift * r.grid.getResolution();
+		const double same_placement_m = screened.options.decision.distinct_shift * r.grid.getResolution();
 		for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
 			EXPECT_LE((a.metric(corner) - b.metric(corner)).norm(), same_placement_m) << corner.transpose();
 		const auto* truth = halmstad()->pair("E5_01", "E5_02");
@@ -256,7 +257,7 @@ TEST(RealMaps, HalmstadScreenDropsOnlyHopelessHypotheses)
 			if (c.screened)
 			{
 				++dropped;
-				EXPECT_LT(c.score, screened.options.relevantScore(best) - screened.options.screen_margin);
+				EXPECT_LT(c.score, screened.options.decision.relevantScore(best) - screened.options.screen_margin);
 				EXPECT_EQ(c.confidence, 0);
 			}
 		EXPECT_GT(dropped, 0u) << "nothing screened on a refused pair";

@@ -5,15 +5,20 @@
 //      → similarity hypotheses (FeatureHypotheses.h)
 //   2. edge points of both maps (EdgePoints.h)
 //   3. each hypothesis refined by trimmed scaling ICP (TsICP.h)
-//   4. the best refinement judged against both maps' cells (MapAgreement.h);
-//      below min_confidence it is reported as not merged.
+//   4. each refinement judged against both maps' cells (MapAgreement.h),
+//      and the pair decided on that evidence (Decision.h); below
+//      min_confidence it is reported as not merged
+//   5. the decided transform finished (Finish.h).
 // Resolution metadata is not needed: everything runs in cell coordinates and
 // the scale between the maps' cells is estimated.
 
+#include <multires_map_merge/Decision.h>
 #include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/Finish.h>
 #include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/LatticeShift.h>
 #include <multires_map_merge/MapAgreement.h>
+#include <multires_map_merge/PreparedMap.h>
 #include <multires_map_merge/Similarity2D.h>
 #include <multires_map_merge/TsICP.h>
 
@@ -29,6 +34,11 @@
 
 namespace multires_map_merge
 {
+namespace pair_search
+{
+struct SearchState;  // src/PairSearch.h
+}
+
 class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 {
    public:
@@ -110,10 +120,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * A larger λ keeps more of the overlap, so the pose balances the
 		 * bends over all of it (the annotation of independent maps is a
 		 * fit over the whole overlap). Tuned on Halmstad E5/HIH, both map
-		 * orders (README). 0: off. */
+		 * orders (docs/method.md, step 6). 0: off. */
 		double finish_bent_lambda = 4.0;
-		// --- Decision (README "How the decision works"; calibrated by
-		// scripts/calibrate_decision.py on Halmstad E5/HIH and CARMEN negatives)
+		// --- Evidence (MapAgreement.h)
 		/** Walls within this many cells of the coarser map agree: independent
 		 * SLAM maps bend and thicken walls by a few cells. */
 		double verify_tolerance = 3.0;
@@ -121,62 +130,11 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * coarse cells along each axis, turns of ± verify_turn_deg. */
 		double verify_shift = 12.0;
 		double verify_turn_deg = 8.0;
-		// Calibrated (scripts/calibrate_decision.py, bench/results/calibration.txt)
-		// on E5/HIH pairs, cross-site, CARMEN, mirror and live-fleet data (growing
-		// partial maps of two buildings: without them a fit placed intel's robot
-		// in fr079), made by this code with these defaults: no wrong calibration
-		// candidate passes, with a margin (README, "How the decision works").
-		double decision_chance_weight = 1.0;
-		/** Evidence discount: the score loses √(decision_evidence / n) for n
-		 * judged wall points (a small overlap proves little). */
-		double decision_evidence = 400;
-		/** The score gains this times min(m, decision_feature_cap) /
-		 * decision_feature_cap for the m feature matches (FeatureHypotheses.h,
-		 * agreeingMatches) that the transform takes onto each other: local
-		 * appearance (corners, door frames, clutter) agreeing where the walls
-		 * do, evidence the walls alone do not give between look-alike
-		 * buildings. 0: walls only. */
-		double decision_feature_weight = 0.2;
-		double decision_feature_cap = 10;
-		/** The best candidate merges on its walls only if they agree more
-		 * than chance by at least this (bent consistency − chance): two
-		 * buildings whose walls agree about as well anywhere (a small map
-		 * against a large one of another building) prove nothing, however
-		 * few rivals they have. 0: no gate beyond B ≥ C. */
-		double decision_min_lead = 0.04;
-		/** The best candidate merges on its walls only if at least this
-		 * share of its wall points lying near a directed wall of the other
-		 * map lie near one running the same way (within 20°;
-		 * TwoWaySupport::wallAlignment): a wrong alignment lays walls across
-		 * walls, which the tolerant consistency counts as agreement. */
-		double decision_min_wall_alignment = 0.7;
-		/** The best candidate merges on its walls only if at least this
-		 * share of adjacent tiles of its moved walls fit best after about the
-		 * same small shift (TwoWayShiftField::coherence): independent maps
-		 * bend smoothly, while a wrong alignment that lays walls near walls
-		 * fits each region by a shift of its own. 0: no gate. */
-		double decision_min_shift_coherence = 0.25;
-		/** The pair's decision value: the best-scoring candidate's score plus
-		 * this times its lead over the best distinct rival (distinct_shift):
-		 * the right alignment of one building stands out, a chance fit of
-		 * two buildings has rivals nearly as good. */
-		double decision_runner_up_weight = 1.0;
-		/** A rival scoring below this counts as this: with no rival, the lead
-		 * is measured from it. */
-		double decision_runner_up_floor = 0.25;
-		/** Candidates whose other-map wall centroids lie more than this many
-		 * coarse cells apart (or turned by over verify_turn_deg, or scaled by
-		 * over 10 %) are rivals, not one answer. Independent maps bend by
-		 * several cells, so a building's right placement refines to optima a
-		 * bend apart (20-35 cells on Halmstad), which must not rival each
-		 * other; calibrated, at most 2 m at 5 cm cells, the displacement the
-		 * benchmark still calls right. */
-		double distinct_shift = 40.0;
-		/** The decision value at which confidence is 0.5; ±0.1 · (1 +
-		 * decision_runner_up_weight) around it spans 0..1. */
-		double decision_threshold = 0.664;
-		/** Below this the result is "not merged". */
-		double min_confidence = 0.5;
+		/** --- Decision (Decision.h; docs/decision.md): calibrated by
+		 * scripts/calibrate_decision.py on Halmstad E5/HIH, cross-site,
+		 * CARMEN, mirror and live-fleet data. Ini keys decision_*,
+		 * distinct_shift and min_confidence (decisionParamFields()). */
+		DecisionParams decision;
 		/** Trust the stated resolutions as a prior on the scale. */
 		bool use_resolution_metadata = false;
 		double metadata_scale_tolerance = 0.15;  //!< relative, with use_resolution_metadata
@@ -195,28 +153,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * with it; alignScaled reports it as not merged. */
 		std::string invalidReason() const;
 
-		/** The lowest candidate score whose decision value can reach
-		 * decision_threshold (with no rival above the floor). */
-		double lowestMergeableScore() const;
-		/** The least score a further candidate needs to matter once the
-		 * best so far scores `best_score`: to merge, to beat it, or as a
-		 * rival to lower its confidence (below confidence 1). */
-		double relevantScore(double best_score) const;
-		/** Decision value per unit of confidence: 0.2 (1 + runner-up weight). */
-		double valuePerConfidence() const;
-		/** Walls agreeing this well (bent consistency) against chance
-		 * may merge on them: they lead chance by decision_min_lead. */
-		bool leadsChance(double bent_consistency, double chance_consistency) const;
-		/** Walls near each other run alike in at least
-		 * decision_min_wall_alignment of the cases. */
-		bool wallsRunAlike(double wall_alignment) const;
-		/** Regions of the walls fit after shifts alike in at least
-		 * decision_min_shift_coherence of adjacent tiles. */
-		bool shiftsCohere(double shift_coherence) const;
-
 		FeatureParams featureParams() const;
 		TsICPParams icpParams() const;
 		LatticeShiftParams latticeParams() const;
+		FinishParams finishParams() const;
 	} options;
 
 	/** One refined hypothesis and how it was judged. */
@@ -229,33 +169,17 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Strict cell consistency (MapAgreement); NaN where the edge RMSE
 		 * (≥ 1.5 coarse cells) already says the maps are not the same cells. */
 		double consistency = 0;
-		/** Tolerant consistency of both maps' wall points (MapAgreement.h,
-		 * twoWaySupport) and the best of it under far perturbations of the
-		 * same transform: what chance gives in these two maps. */
-		double tolerant_consistency = 0, chance_consistency = 0;
-		double support = 0;  //!< share of wall points near a wall of the other map
-		double chance_support = 0;  //!< the best support under the same far perturbations
-		/** Of the wall points near a wall of the other map, the share near
-		 * one running the same way (TwoWaySupport::wallAlignment). */
-		double wall_alignment = 0;
-		/** Of adjacent tiles of the moved walls, the share whose best small
-		 * shifts agree (TwoWayShiftField::coherence). */
-		double shift_coherence = 0;
-		/** Feature matches this transform takes onto each other
-		 * (decision_feature_weight). */
-		size_t feature_agreement = 0;
-		/** The tolerant consistency with each tile of the moved walls shifted
-		 * as its neighbours fit best (TwoWayShiftField::bentConsistency): as
-		 * if a smooth bend were taken out. */
-		double bent_consistency = 0;
-		size_t judged_points = 0;  //!< wall points on seen space, weaker direction
-		/** bent_consistency + chance_weight · (it − chance) − √(evidence / judged) */
+		/** What the decision reads (Decision.h), measured on every point
+		 * (on a sample for a screened candidate). */
+		Evidence evidence;
+		/** DecisionParams::score of the evidence. */
 		double score = 0;
-		/** From the cells alone (the maps coincide cell for cell); 0 when they cannot. */
-		double exact_confidence = 0;
+		double objective = 0;  //!< TsICP's ψ, squared reference cells
 		/** Where the other map's wall centroid lands in the reference (cells):
 		 * tells rival candidates apart. */
 		Eigen::Vector2d other_centre{0, 0};
+		/** Where the candidate puts the other map (rivals are told apart by it). */
+		Placement placement() const { return {cells, other_centre}; }
 		/** For the pair's best-scoring candidate only: the best distinct
 		 * rival's score (at least decision_runner_up_floor) and the decision
 		 * value score + runner_up_weight · (score − runner_up_score). */
@@ -297,13 +221,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double overlap = 0;  //!< TsICP's ξ
 		double objective = 0;  //!< TsICP's ψ, squared reference cells
 		double trimmed_rmse_coarse_cells = 0;  //!< √e(ξ) in cells of the coarser map
-		/** Tolerant consistency of the chosen candidate (TCandidate), and
-		 * the best of it under far perturbations (chance). */
-		double consistency = 0, chance_consistency = 0;
-		double wall_alignment = 0;  //!< TCandidate::wall_alignment of the chosen candidate
-		double shift_coherence = 0;  //!< TCandidate::shift_coherence of the chosen candidate
-		double bent_consistency = 0;  //!< TCandidate::bent_consistency of the chosen candidate
-		size_t feature_agreement = 0;  //!< TCandidate::feature_agreement of the chosen candidate
+		Evidence evidence;  //!< of the chosen candidate
 		/** The chosen candidate's score, and where it is the pair's best-
 		 * scoring one, its best distinct rival's score and the decision value
 		 * (TCandidate; NaN otherwise). */
@@ -326,57 +244,15 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		std::map<std::string, double> stage_seconds;
 	};
 
-	/** One map as the aligner sees it: its class image, feature pyramid,
-	 * edge points and occupancy field. Preparing is most of an alignment's
-	 * time, and a map in a fleet takes part in several pairs: prepare it
-	 * once, align it in each. Valid with the options it was prepared with
-	 * (alignScaled refuses maps prepared with other feature options). */
-	struct TPreparedMap
-	{
-		/** Why this map cannot be aligned, after "reference map " or "other
-		 * map " ("" when it can): no structure, too small or too large. */
-		std::string problem;
-		double resolution = 0;  //!< as stated
-		Similarity2D cell_to_metric;  //!< the grid's cells → its metric frame
-		cv::Mat classes;  //!< GridImage.h
-		FeatureParams feature_params;  //!< those the features were extracted with
-		std::vector<LevelFeatures> features;
-		PointList edges;
-		/** On `edges`, built once: every hypothesis's TsICP moves one map's
-		 * edges, either map's (null with fewer than 3 edge points). */
-		std::shared_ptr<const PointKDTree> edge_tree;
-		OccupancyField field;
-		std::map<std::string, double> stage_seconds;  //!< features, edges
-	};
-	using PreparedMapPtr = std::shared_ptr<const TPreparedMap>;
-
-	/** Rivals, not one answer found twice: the candidates put the other map
-	 * elsewhere (its wall centroid more than distinct_shift coarse cells
-	 * apart, turned by more than verify_turn_deg, or scaled by over 10 %). */
-	bool areRivals(const TCandidate& a, const TCandidate& b) const;
-	/** The candidate's walls may decide a merge: they lead chance
-	 * (leadsChance), run alike (wallsRunAlike) and shift alike region by
-	 * region (shiftsCohere). */
-	bool mayMergeOnWalls(const TCandidate& c) const;
+	/** One map as the aligner sees it (PreparedMap.h). Valid with the
+	 * options it was prepared with (alignScaled refuses maps prepared with
+	 * other feature options). */
+	using TPreparedMap = PreparedMap;
+	using PreparedMapPtr = multires_map_merge::PreparedMapPtr;
 
 	/** Prepares one map with these options. Never throws on bad content:
 	 * the map's `problem` says what is wrong. */
 	PreparedMapPtr prepare(const mrpt::maps::COccupancyGridMap2D& grid) const;
-
-	/** The finish on occupied cells (icp_finish_on_occupied) of a transform
-	 * between prepared maps' cells, on its own: what align() applies to the
-	 * decided transform (when it moves no wall by more than
-	 * finish_max_shift), exposed so the benchmark can start it from the truth. */
-	Similarity2D finishOnOccupied(const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells) const;
-	/** The refit over the whole overlap (finish_bent_lambda) of a transform
-	 * between prepared maps' cells whose edges are `rmse_coarse_cells`
-	 * apart (TCandidate::rmse_coarse_cells): what align() reports for the
-	 * decided candidate. `cells` itself when off, below 1.5 coarse cells
-	 * (finishOnOccupied's), or when the refit would place the other map
-	 * elsewhere (a rival, areRivals). Exposed so the benchmark judges every
-	 * candidate as it would be reported. */
-	Similarity2D finishBent(
-		const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells) const;
 
 	/** The full similarity between two grids. Never throws on bad map
 	 * content: the reason is in TReturnInfo::message with success = false. */
@@ -418,18 +294,13 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
 
    private:
-	/** Features, edge points and occupancy field of a map's `classes`. */
-	void describe(TPreparedMap& map) const;
-	/** The map's edge points and the k-d tree on them (none below 3 points). */
-	static void setEdges(TPreparedMap& map, PointList edges);
-	/** The map with its x axis flipped, described (mirror_check). */
-	PreparedMapPtr mirrored(const TPreparedMap& map) const;
-	/** With `mirror_pass_relevant`: the search of mirror_check on the
-	 * mirrored other map (no structure, no finish, no check of its own);
-	 * hypotheses scoring below that score (less screen_margin) are screened. */
+	/** The search, decision and finish of one pair (a given start first). */
 	TReturnInfo align(
-		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric,
-		std::optional<double> mirror_pass_relevant = std::nullopt) const;
+		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
+	/** mirror_check: the other map aligned mirrored (feature hypotheses
+	 * only); its candidates join `search` as rivals. Returns their best
+	 * score (NaN with none judged in full). */
+	double mirrorPass(const TPreparedMap& ref, const TPreparedMap& other, pair_search::SearchState& search) const;
 };
 
 }  // namespace multires_map_merge

@@ -10,6 +10,8 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <opencv2/core.hpp>
 
+#include <cmath>
+
 namespace multires_map_merge
 {
 /** The three cell classes, as grey levels (dark = occupied, as maps are drawn). */
@@ -51,5 +53,12 @@ cv::Mat resampleClasses(const cv::Mat& classes, double factor);
 
 /** A class image as people expect to see a map: +y up. */
 cv::Mat forDisplay(const cv::Mat& classes);
+
+/** Whether `cell` (cell coordinates) rounds to a set cell of the CV_8U `mask`. */
+inline bool onMask(const cv::Mat& mask, const Eigen::Vector2d& cell)
+{
+	const int x = static_cast<int>(std::lround(cell.x())), y = static_cast<int>(std::lround(cell.y()));
+	return x >= 0 && y >= 0 && x < mask.cols && y < mask.rows && mask.at<uint8_t>(y, x);
+}
 
 }  // namespace multires_map_merge

@@ -1,0 +1,61 @@
+#pragma once
+// One map as the aligner sees it (its class image, feature pyramid, edge
+// points and occupancy field), and the refinement of a transform between two
+// such maps. Preparing is most of an alignment's time, and a map in a fleet
+// takes part in several pairs: prepare it once, align it in each.
+
+#include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/MapAgreement.h>
+#include <multires_map_merge/PointKDTree.h>
+#include <multires_map_merge/Similarity2D.h>
+#include <multires_map_merge/TsICP.h>
+
+#include <opencv2/core.hpp>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace multires_map_merge
+{
+struct PreparedMap
+{
+	/** Why this map cannot be aligned, after "reference map " or "other
+	 * map " ("" when it can): no structure, too small or too large. */
+	std::string problem;
+	double resolution = 0;  //!< as stated
+	Similarity2D cell_to_metric;  //!< the grid's cells → its metric frame
+	cv::Mat classes;  //!< GridImage.h
+	FeatureParams feature_params;  //!< those the features were extracted with
+	std::vector<LevelFeatures> features;
+	PointList edges;
+	/** On `edges`, built once: every hypothesis's TsICP moves one map's
+	 * edges, either map's (null with fewer than 3 edge points). */
+	std::shared_ptr<const PointKDTree> edge_tree;
+	OccupancyField field;
+	std::map<std::string, double> stage_seconds;  //!< features, edges
+};
+using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
+
+/** Features, edge points and occupancy field of a map's `classes`, with its
+ * `feature_params`. */
+void describeMap(PreparedMap& map);
+
+/** The map with its x axis flipped, described (the aligner's mirror check). */
+PreparedMapPtr mirroredMap(const PreparedMap& map);
+
+/** The centroid of the map's edge points (cells): where a placement puts
+ * the map is told apart by where this lands. */
+Eigen::Vector2d wallCentroid(const PreparedMap& map);
+
+/** TsICP from `start` (other → ref cells), with the map that lies more
+ * inside the other as the fixed set (TsICP trims to the share of the fixed
+ * set that finds a partner: a small map inside a large one). With
+ * `fixed_points` > 0, the fixed set is sampled to about that many points.
+ * The result is always other → ref, in reference cells. */
+TsICPResult refineFromTheInside(
+	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& start, const TsICPParams& ip,
+	size_t fixed_points = 0);
+
+}  // namespace multires_map_merge

@@ -1,0 +1,95 @@
+#pragma once
+// The search of one pair of prepared maps (the aligner's steps 3 and 4): each
+// hypothesis refined by TsICP (screened on a sample first) and judged, a few
+// at once; the candidates and the evidence the decision reads. Internal to
+// the aligner: not installed.
+
+#include <multires_map_merge/CScalingGridMapAligner.h>
+
+#include <mrpt/system/COutputLogger.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace multires_map_merge::pair_search
+{
+using Aligner = CScalingGridMapAligner;
+
+/** What every step of one pair reads; constant while it runs. */
+struct PairContext
+{
+	const PreparedMap& ref;
+	const PreparedMap& other;
+	const Aligner::TConfigParams& options;
+	const mrpt::system::COutputLogger& log;
+	/** Feature matches of every pyramid level pair: RANSAC's input, and
+	 * evidence about each candidate (Evidence::feature_agreement). */
+	std::vector<LevelMatches> matches;
+	Eigen::Vector2d other_centroid{0, 0};  //!< wallCentroid(other): where a placement puts it
+	std::optional<double> expected_scale;  //!< with use_resolution_metadata
+	TsICPParams icp;
+
+	/** A finite transform at a scale allowed (use_resolution_metadata). */
+	bool usable(const Similarity2D& t) const;
+};
+
+/** The context of a pair; the feature matching is timed as "matches". */
+PairContext makeContext(
+	const PreparedMap& ref, const PreparedMap& other, const Aligner::TConfigParams& options,
+	const mrpt::system::COutputLogger& log, std::map<std::string, double>& stage_seconds);
+
+/** The evidence about a transform, judged on at most `most` points per map;
+ * with fewer than a full judgement takes, the judged count is the one it
+ * would take. Wall alignment only `in_full`: a screen never decides. */
+struct Judgement
+{
+	TwoWayShiftField bends;  //!< the tiles' best shifts (what the bend refit follows)
+	Evidence evidence;
+	double score = 0;
+};
+Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool in_full);
+
+/** A candidate's hypothesis and TsICP result: what the report needs of it. */
+struct Refinement
+{
+	Hypothesis h;
+	TsICPResult r;
+};
+
+/** The search's state over every hypothesis list of a pair. */
+struct SearchState
+{
+	/** Below this score a hypothesis can neither merge nor, as a rival,
+	 * lower the best candidate's confidence (the mirror pass's bar is the
+	 * best score found before it). */
+	double least_relevant = 0;
+	std::vector<Aligner::TCandidate> candidates;  //!< in the order refined
+	std::vector<Refinement> refinements;  //!< one per candidate
+	/** Candidates whose maps coincide cell for cell: a hypothesis whose
+	 * sample refinement lands on one is not refined again. */
+	std::vector<Aligner::TCandidate> exact_found;
+	size_t hypotheses = 0, hypotheses_refined = 0;
+	std::map<std::string, double> stage_seconds;  //!< icp, verify (summed over threads), ransac, structure
+};
+
+/** Refines (up to max_hypotheses of) `list` in rounds, adding to `state`. */
+void refineAll(const PairContext& c, SearchState& state, const std::vector<Hypothesis>& list);
+
+/** A given start refined: other's grid metric frame → ref's (tracking). */
+void refineStart(const PairContext& c, SearchState& state, const Similarity2D& start_metric);
+/** RANSAC's hypotheses of every pyramid level pair (timed as "ransac"), refined. */
+void refineFeatureHypotheses(const PairContext& c, SearchState& state);
+/** The buildings' structure's hypotheses (StructureHypotheses.h; timed as
+ * "structure"), refined. */
+void refineStructureHypotheses(const PairContext& c, SearchState& state);
+
+/** The best score of a candidate judged in full (not mirrored); -inf if none. */
+double bestScore(const std::vector<Aligner::TCandidate>& candidates);
+
+/** The decision's view of a candidate. */
+DecisionCandidate decisionInput(const Aligner::TCandidate& c);
+std::vector<DecisionCandidate> decisionInput(const std::vector<Aligner::TCandidate>& candidates);
+
+}  // namespace multires_map_merge::pair_search

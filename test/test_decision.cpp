@@ -1,0 +1,190 @@
+// The decision module on fixed evidence: no maps, no ICP. What the aligner,
+// the benchmark and decision-replay all call.
+#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/Decision.h>
+
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <cmath>
+#include <set>
+#include <string>
+
+using namespace multires_map_merge;
+
+namespace
+{
+/** Walls that agree well above chance, run alike and bend smoothly. */
+Evidence strongWalls(double bent)
+{
+	Evidence e;
+	e.tolerant_consistency = bent - 0.05;
+	e.bent_consistency = bent;
+	e.chance_consistency = 0.45;
+	e.wall_alignment = 0.85;
+	e.shift_coherence = 0.5;
+	e.feature_agreement = 10;
+	e.judged_points = 4000;
+	return e;
+}
+
+DecisionCandidate at(const Evidence& e, double x, double yaw_deg = 0, double scale = 1)
+{
+	DecisionCandidate c;
+	c.evidence = e;
+	c.placement.cells = Similarity2D(scale, yaw_deg * M_PI / 180, {x, 0});
+	c.placement.other_centre = {x, 0};
+	return c;
+}
+}  // namespace
+
+TEST(Decision, ScoreIsTheDocumentedSum)
+{
+	DecisionParams p;
+	const Evidence e = strongWalls(0.9);
+	const double expected = 0.9 + p.chance_weight * (0.9 - 0.45) - std::sqrt(p.evidence / 4000) +
+		p.feature_weight * std::min(10.0, p.feature_cap) / p.feature_cap;
+	EXPECT_DOUBLE_EQ(p.score(e), expected);
+	// Fewer judged points prove less; more feature matches than the cap gain nothing.
+	Evidence small = e;
+	small.judged_points = 100;
+	EXPECT_LT(p.score(small), p.score(e));
+	Evidence many = e;
+	many.feature_agreement = 1000;
+	EXPECT_DOUBLE_EQ(p.score(many), p.score(e) + p.feature_weight * (std::min(1000.0, p.feature_cap) - 10) / p.feature_cap);
+}
+
+TEST(Decision, ConfidenceIsHalfAtTheThresholdAndStaysInZeroOne)
+{
+	DecisionParams p;
+	EXPECT_DOUBLE_EQ(p.confidenceOfValue(p.threshold), 0.5);
+	EXPECT_DOUBLE_EQ(p.confidenceOfValue(p.threshold + 0.5 * p.valuePerConfidence()), 1.0);
+	EXPECT_DOUBLE_EQ(p.confidenceOfValue(-100), 0.0);
+	EXPECT_DOUBLE_EQ(p.confidenceOfValue(100), 1.0);
+}
+
+TEST(Decision, TheBestScoringCandidateIsDecidedAgainstItsBestDistinctRival)
+{
+	DecisionParams p;
+	// Walls agreeing moderately, no feature matches: confidence below 1.
+	auto moderate = [](double bent) {
+		Evidence e = strongWalls(bent);
+		e.feature_agreement = 0;
+		return e;
+	};
+	const DecisionCandidate best = at(moderate(0.62), 0);
+	// A rival far away (a placement elsewhere) and a near twin (the same
+	// placement, a bend apart): only the rival lowers the decision value.
+	const DecisionCandidate rival = at(moderate(0.6), 10 * p.distinct_shift);
+	const DecisionCandidate twin = at(moderate(0.61), 0.5 * p.distinct_shift);
+	const Decision alone = decide({best, twin}, p);
+	ASSERT_TRUE(alone.best && alone.chosen);
+	EXPECT_EQ(*alone.best, 0u);
+	EXPECT_DOUBLE_EQ(alone.runner_up_score, p.runner_up_floor);
+	const Decision against = decide({best, twin, rival}, p);
+	EXPECT_DOUBLE_EQ(against.runner_up_score, p.score(rival.evidence));
+	EXPECT_DOUBLE_EQ(
+		against.value, against.scores[0] + p.runner_up_weight * (against.scores[0] - against.runner_up_score));
+	EXPECT_LT(against.value, alone.value);
+	EXPECT_GT(alone.confidence[0], 0);
+	EXPECT_LT(against.confidence[0], alone.confidence[0]);
+	// Turned or scaled beyond the bounds, the same centre is a rival too.
+	EXPECT_TRUE(p.areRivals(best.placement, at(strongWalls(0.8), 0, 2 * p.distinct_turn_deg).placement));
+	EXPECT_TRUE(p.areRivals(best.placement, at(strongWalls(0.8), 0, 0, 1.5).placement));
+	EXPECT_FALSE(p.areRivals(best.placement, twin.placement));
+}
+
+TEST(Decision, MirroredAndScreenedCandidatesAreNeverChosen)
+{
+	DecisionParams p;
+	// The mirrored other map's candidate at the very same placement: a rival
+	// all the same (a map that fits itself mirrored proves nothing by its
+	// walls). A screened one scoring higher is neither chosen nor a rival.
+	DecisionCandidate mirrored = at(strongWalls(0.95), 0);
+	mirrored.mirrored = true;
+	DecisionCandidate screened = at(strongWalls(0.99), 1000);
+	screened.screened = true;
+	const DecisionCandidate right = at(strongWalls(0.9), 0);
+	const Decision d = decide({mirrored, screened, right}, p);
+	ASSERT_TRUE(d.best && d.chosen);
+	EXPECT_EQ(*d.best, 2u);
+	EXPECT_EQ(*d.chosen, 2u);
+	EXPECT_DOUBLE_EQ(d.runner_up_score, p.score(mirrored.evidence));
+	EXPECT_DOUBLE_EQ(decide({screened, right}, p).runner_up_score, p.runner_up_floor);
+	EXPECT_LT(d.value, decide({right}, p).value);
+}
+
+TEST(Decision, EachGateRefusesOnItsOwnAndSaysSo)
+{
+	DecisionParams p;
+	const DecisionCandidate good = at(strongWalls(0.9), 0);
+	const Decision merged = decide({good}, p);
+	ASSERT_TRUE(merged.merged);
+	struct Case
+	{
+		double Evidence::*member;
+		double value;
+		const char* reason;
+	};
+	for (const Case& c : {Case{&Evidence::chance_consistency, 0.89, "no more than chance"},
+						  Case{&Evidence::wall_alignment, 0.5, "running alike"},
+						  Case{&Evidence::shift_coherence, 0.1, "shifts alike"}})
+	{
+		SCOPED_TRACE(c.reason);
+		DecisionCandidate gated = good;
+		gated.evidence.*c.member = c.value;
+		const Decision d = decide({gated}, p);
+		EXPECT_FALSE(d.merged);
+		EXPECT_DOUBLE_EQ(d.confidence[0], 0.0);
+		EXPECT_NE(refusalReasons(gated.evidence, d, p).find(c.reason), std::string::npos)
+			<< refusalReasons(gated.evidence, d, p);
+	}
+	// Too few judged points: not decided on its walls at all.
+	DecisionCandidate tiny = good;
+	tiny.evidence.judged_points = DecisionParams::min_judged_points - 1;
+	const Decision d = decide({tiny}, p);
+	EXPECT_FALSE(d.best);
+	EXPECT_FALSE(d.merged);
+	// Coinciding cells merge whatever the walls' score.
+	tiny.evidence.exact_confidence = 0.9;
+	EXPECT_TRUE(decide({tiny}, p).merged);
+}
+
+TEST(Decision, EvidenceAndParameterListsNameEveryFieldOnce)
+{
+	// Every member once: set each through the list to a value of its own.
+	std::set<std::string> names;
+	Evidence e;
+	for (size_t i = 0; i < evidenceFields().size(); ++i) e.*evidenceFields()[i].member = double(i + 1);
+	std::set<double> values;
+	for (const auto& f : evidenceFields()) names.insert(f.name), values.insert(e.*f.member);
+	EXPECT_EQ(names.size(), evidenceFields().size());
+	EXPECT_EQ(values.size(), evidenceFields().size());
+	EXPECT_EQ(sizeof(Evidence), evidenceFields().size() * sizeof(double)) << "a field missing from evidenceFields()";
+
+	const DecisionParams defaults;
+	EXPECT_EQ(defaults.invalidReason(), "");
+	std::set<std::string> keys;
+	for (const auto& f : decisionParamFields()) keys.insert(f.key);
+	EXPECT_EQ(keys.size(), decisionParamFields().size());
+	// Saved to an ini file and loaded by its keys, every value comes back
+	// exactly (a third is no short decimal); one out of range is named.
+	CScalingGridMapAligner::TConfigParams a;
+	for (const auto& f : decisionParamFields()) a.decision.*f.member = f.lo + std::min(f.hi - f.lo, 2.0) / 3;
+	a.icp_relative_tolerance = 1e-7;  // MRPT's own "%f" would save it as 0
+	const std::string path = ::testing::TempDir() + "/decision_roundtrip.ini";
+	{
+		mrpt::config::CConfigFile out(path);
+		a.saveToConfigFile(out, "aligner");
+	}
+	CScalingGridMapAligner::TConfigParams b;
+	b.loadFromConfigFile(mrpt::config::CConfigFile(path), "aligner");
+	for (const auto& f : decisionParamFields()) EXPECT_EQ(b.decision.*f.member, a.decision.*f.member) << f.key;
+	EXPECT_EQ(b.icp_relative_tolerance, 1e-7);
+	mrpt::config::CConfigFileMemory bad;
+	bad.write("aligner", "decision_min_wall_alignment", 2.0);
+	CScalingGridMapAligner::TConfigParams c;
+	EXPECT_THROW(c.loadFromConfigFile(bad, "aligner"), std::invalid_argument);
+	EXPECT_NE(c.decision.invalidReason().find("decision_min_wall_alignment"), std::string::npos);
+}
