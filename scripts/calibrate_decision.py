@@ -81,7 +81,7 @@ and warps) has other hypotheses, hence other rivals, and a wrong candidate's
 value moves with its rival's score times the runner-up weight. The fit must
 hold on every sample given; merges are counted over all of them. The
 defaults need not be the top line: a fit may fail a negative the data lacks
-(README, "How the decision works").
+(docs/decision.md).
 
 The data comes from `multires_bench --calibration-data`: the aligner as it
 runs (the screen on), with exhaustive_search so that every hypothesis is
@@ -94,14 +94,18 @@ data and check that the fit stays.
 """
 import collections
 import csv
+import io
 import itertools
 import math
+import os
+import subprocess
 import sys
+import tempfile
 
 # Safety margin above the highest wrong value, in score units: the decision
 # value moves (1 + runner-up weight) times as much as a score, so the margin
 # does too (a quarter of the confidence scale, 0.2 (1 + weight) per unit).
-# Why this large: README, "How the decision works".
+# Why this large: docs/decision.md, "The current defaults".
 MARGIN = 0.05
 # The gates need margins too: a wrong pair's wall alignment or lead over
 # chance moves by a few hundredths with the machine and build (other
@@ -174,7 +178,7 @@ def load(paths):
                     "H": float(r.get("shift_coherence") or "nan"),
                     # Absent from data written before it was measured: none.
                     "F": int(r.get("feature_agreement") or 0),
-                    "n": max(1, int(r["judged"])),
+                    "n": max(1.0, float(r["judged"])),
                     "scale": float(r["scale"]),
                     "yaw": math.radians(float(r["yaw_deg"])),
                     "centre": (float(r["centre_x"]), float(r["centre_y"])),
@@ -278,11 +282,22 @@ def main():
         for _, _, line in sorted(fits, key=lambda f: f[0], reverse=True)[:TOP_FITS]:
             print(line)
     _, w, e, fw, fcap, k, floor, lead, align, coh, ds, threshold, merged_right, live_right, per_file = best
-    print(f"\n[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
-          f"decision_feature_weight = {fw}\ndecision_feature_cap = {fcap}\ndecision_min_lead = {lead}\n"
-          f"decision_min_wall_alignment = {align}\ndecision_min_shift_coherence = {coh}\n"
-          f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\ndistinct_shift = {ds}\n"
-          f"decision_threshold = {threshold:.3f}")
+    ini = (f"[aligner]\ndecision_chance_weight = {w}\ndecision_evidence = {e}\n"
+           f"decision_feature_weight = {fw}\ndecision_feature_cap = {fcap}\ndecision_min_lead = {lead}\n"
+           f"decision_min_wall_alignment = {align}\ndecision_min_shift_coherence = {coh}\n"
+           f"decision_runner_up_weight = {k}\ndecision_runner_up_floor = {floor}\ndistinct_shift = {ds}\n"
+           f"decision_threshold = {threshold:.3f}\n")
+    print("\n" + ini, end="")
+    # The fit as the aligner decides it (its own code, not this script's).
+    replayed = replay(paths, ini)
+    if replayed is None:
+        print("# decision-replay not built: the fit was not replayed by the aligner's decision")
+    else:
+        print(f"# replayed by the aligner's decision (decision-replay): {replayed[0]} positive pairs merged right, "
+              f"{replayed[1]} merged wrong")
+        if replayed != (merged_right, 0):
+            sys.exit(f"calibrate_decision.py: the aligner's decision disagrees with this script's: {replayed} "
+                     f"against ({merged_right}, 0)")
     print(f"# calibration: {merged_right}/{len(positives)} positive pairs merged right, 0 wrong "
           f"(margin {MARGIN} x (1 + runner-up weight) above the highest wrong value); live fleet pairs merged right "
           f"{live_right}/{len(live)}")
@@ -291,6 +306,33 @@ def main():
         n_later = sum(1 for key in positives if key[3] == path and key[1] > key[2])
         print(f"#   {path}: {per_file[(path, True)] + per_file[(path, False)]}/{n} positive pairs merged right, "
               f"{per_file[(path, True)]}/{n_later} with the later map as REF (the report's order)")
+
+
+def replay(paths, ini_text):
+    """The fit replayed by the aligner's own decision (decision-replay): the
+    calibration positives merged right and the pairs merged wrong, over all
+    samples, by the same rules as above. None when the tool is not built."""
+    tool = os.environ.get("DECISION_REPLAY") or os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "build", "devel", "lib", "multires_map_merge",
+        "decision-replay")
+    if not os.path.exists(tool):
+        return None
+    with tempfile.NamedTemporaryFile("w", suffix=".ini") as ini:
+        ini.write(ini_text)
+        ini.flush()
+        right = wrong = 0
+        for path in paths:
+            out = subprocess.run([tool, path, "--config", ini.name], check=True, capture_output=True, text=True).stdout
+            for r in csv.DictReader(io.StringIO(out)):
+                if r["calibration"] != "1" or r["merged"] != "1":
+                    continue
+                near = (r["site"] == "live" and r["right"] != "1" and r["error"] != "nan"
+                        and float(r["error"]) <= LIVE_NEAR_CELLS)
+                if r["right"] == "1":
+                    right += r["site"] != "live"
+                elif not near:
+                    wrong += 1
+    return right, wrong
 
 
 if __name__ == "__main__":
