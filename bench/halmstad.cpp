@@ -106,7 +106,7 @@ std::vector<HalmstadPair> HalmstadData::unorderedPairs(const std::string& site) 
 
 std::string HalmstadData::png(const std::string& map) const
 {
-	return root_ + "/maps/" + siteOf(map) + "/pseudo_occupancy/" + map + ".png";
+	return root_ + "/maps/" + siteOf(map) + (isSensorMap(map) ? "/pseudo_occupancy/" : "/layout/") + map + ".png";
 }
 
 std::string HalmstadData::yaml(const std::string& map, const std::string& dir) const

@@ -53,6 +53,8 @@ class HalmstadData
 	explicit HalmstadData(const std::string& root);
 
 	std::vector<std::string> sites() const { return {"E5", "F5", "HIH", "KPT4A"}; }
+	/** The site's floor plan (its `layout` PNG) as a map name: E5_layout. */
+	static std::string floorPlan(const std::string& site) { return site + "_layout"; }
 	/** The sensor maps of a site, sorted (E5_01 …). */
 	std::vector<std::string> sensorMaps(const std::string& site) const;
 	/** The annotated ordered pair src → dst, or nullptr. */
@@ -60,6 +62,7 @@ class HalmstadData
 	/** Every unordered sensor-to-sensor pair of a site once (src < dst). */
 	std::vector<HalmstadPair> unorderedPairs(const std::string& site) const;
 
+	/** A sensor map's PNG, or a floor plan's (RGBA: transparent outside). */
 	std::string png(const std::string& map) const;
 	/** A map_server yaml for `map` at 0.05 m in `dir` (written once). */
 	std::string yaml(const std::string& map, const std::string& dir) const;

@@ -41,6 +41,8 @@
 #include <random>
 #include <sstream>
 
+#include "coarser_other.h"
+#include "floor_plans.h"
 #include "halmstad.h"
 #include "live_fleet.h"
 #include "mrpt_anchor.h"
@@ -909,6 +911,9 @@ void runExtraCalibrationNegatives(const HalmstadData& data)
 }
 
 // ---------------------------------------------------------------- real independent maps (Halmstad)
+/** OTHER's cells this many times larger (issue 35: 2× and 3.3×). */
+const std::vector<double> kCoarserFactors = {2.0, 3.3};
+
 struct HalmstadRun
 {
 	std::string site, ref, other;
@@ -1097,6 +1102,12 @@ int main(int argc, char** argv)
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
 	TCLAP::SwitchArg live_pairs_arg(
 		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
+	TCLAP::ValueArg<std::string> coarser_arg(
+		"", "coarser-only", "only the coarser-OTHER section (×2, ×3.3) on these sites (e.g. F5,KPT4A)", false, "", "SITES",
+		cmd);
+	TCLAP::ValueArg<std::string> floor_plans_arg(
+		"", "floor-plans-only", "only the floor-plan section, sensor maps of these sites (e.g. E5,HIH) on every plan", false,
+		"", "SITES", cmd);
 	TCLAP::ValueArg<std::string> halmstad_arg(
 		"", "halmstad-only", "only the real-independent-maps section, on these sites (e.g. E5,HIH)", false, "", "SITES", cmd);
 	TCLAP::ValueArg<int> negatives_arg(
@@ -1167,6 +1178,31 @@ int main(int argc, char** argv)
 			if (!extra_arg.getValue()) runLiveFleetCalibrationPairs();
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
+		}
+		if (coarser_arg.isSet())
+		{
+			std::vector<std::string> sites;
+			std::stringstream list(coarser_arg.getValue());
+			for (std::string site; std::getline(list, site, ',');) sites.push_back(site);
+			const std::string dir = (fs::temp_directory_path() / ("multires_bench_coarser_" + std::to_string(getpid()))).string();
+			const auto runs = runCoarserOther(HalmstadData(g_data + "/halmstad"), sites, kCoarserFactors, g_aligner_options, dir);
+			fs::remove_all(dir);
+			writeCoarserSection(std::cout, runs);
+			size_t wrong = 0;
+			for (const auto& r : runs) wrong += r.merged && !r.outcome.right;
+			return wrong == 0 ? 0 : 1;
+		}
+		if (floor_plans_arg.isSet())
+		{
+			std::vector<std::string> sites;
+			std::stringstream list(floor_plans_arg.getValue());
+			for (std::string site; std::getline(list, site, ',');) sites.push_back(site);
+			const std::string dir = (fs::temp_directory_path() / ("multires_bench_plans_" + std::to_string(getpid()))).string();
+			const auto runs = runFloorPlans(HalmstadData(g_data + "/halmstad"), sites, g_aligner_options, dir);
+			fs::remove_all(dir);
+			writeFloorPlanSection(std::cout, runs);
+			const FloorPlanTotals t = floorPlanTotals(runs);
+			return t.merged_wrong + t.negatives_merged == 0 ? 0 : 1;
 		}
 		if (halmstad_arg.isSet())
 		{
@@ -1252,6 +1288,18 @@ int main(int argc, char** argv)
 			}
 			else
 				halmstad = runHalmstad(data, data.sites(), 6);
+		}
+		// 3c. Floor plans: every sensor map on every site's plan; 3d. OTHER
+		// recorded as a coarser grid.
+		std::vector<FloorPlanRun> floor_plans;
+		std::vector<CoarserRun> coarser;
+		if (!quick)
+		{
+			const std::string dir = (fs::temp_directory_path() / ("multires_bench_plans_" + std::to_string(getpid()))).string();
+			const HalmstadData data(g_data + "/halmstad");
+			floor_plans = runFloorPlans(data, data.sites(), g_aligner_options, dir);
+			coarser = runCoarserOther(data, data.sites(), kCoarserFactors, g_aligner_options, dir);
+			fs::remove_all(dir);
 		}
 		CScalingGridMapAligner::TReturnInfo willow;
 		{
@@ -1568,6 +1616,9 @@ int main(int argc, char** argv)
 		   << num(willow.metric.scale, 4) << ", confidence " << num(willow.confidence, 2)
 		   << " (reference and tolerance: README, test_real_maps).\n";
 
+		if (!floor_plans.empty()) writeFloorPlanSection(md, floor_plans);
+		if (!coarser.empty()) writeCoarserSection(md, coarser);
+
 		md << "\n## Scaling\n\nThe fr079 pair at finer and finer resolution, each map padded with unknown cells to a square "
 		  "(the other at half the reference's resolution, rotated 30°), aligned in a fresh process.\n\n"
 		  "*Whole process*: the child from start to exit (loading both `.gridmap` files, aligning, exiting).\n\n"
@@ -1686,6 +1737,26 @@ int main(int argc, char** argv)
 				   std::to_string(halm_wrong + cross_merged), halm_wrong + cross_merged == 0);
 			target("Halmstad runtime per pair no worse than before (median 1.1 s)", num(median(halm_secs), 2) + " s",
 				   median(halm_secs) <= 1.1);
+			const FloorPlanTotals plans = floorPlanTotals(floor_plans);
+			target("floor plans F5 + KPT4A (acceptance) ≥ 17 / 18 merged right",
+				   std::to_string(plans.acceptance_right) + " / " + std::to_string(plans.acceptance_pairs),
+				   plans.acceptance_right >= 17);
+			target("floor plans E5 + HIH ≥ 16 / 18 merged right",
+				   std::to_string(plans.calibration_right) + " / " + std::to_string(plans.calibration_pairs),
+				   plans.calibration_right >= 16);
+			for (const auto& [factor, share] : {std::pair{kCoarserFactors[0], 0.95}, std::pair{kCoarserFactors[1], 0.9}})
+			{
+				const CoarserTotals acc = coarserTotals(coarser, factor, false), cal = coarserTotals(coarser, factor, true);
+				target("OTHER " + num(factor, 1) + "× coarser, F5 + KPT4A ≥ " + num(100 * share, 0) + " % merged right, 0 wrong",
+					   std::to_string(acc.right) + " / " + std::to_string(acc.pairs) + ", " +
+						   std::to_string(acc.wrong + cal.wrong) + " wrong (E5 + HIH " + std::to_string(cal.right) +
+						   " / " + std::to_string(cal.pairs) + ")",
+					   acc.right >= share * acc.pairs && acc.wrong + cal.wrong == 0);
+			}
+			target("0 merged wrong over floor plans: own plan and every other site's",
+				   std::to_string(plans.merged_wrong + plans.negatives_merged) + " (of " +
+					   std::to_string(plans.negatives) + " negatives)",
+				   plans.merged_wrong + plans.negatives_merged == 0);
 		}
 		md.close();
 		std::cout << "wrote " << out << "/REPORT.md (" << num(total_s, 0) << " s)" << std::endl;
