@@ -108,22 +108,8 @@ CoarserTotals coarserTotals(const std::vector<CoarserRun>& runs, double factor, 
 
 void writeCoarserSection(std::ostream& md, const std::vector<CoarserRun>& runs)
 {
-	struct Row
-	{
-		size_t pairs = 0, right = 0, refused = 0, wrong = 0;
-	};
-	std::map<std::pair<double, std::string>, Row> rows;
-	for (const auto& r : runs)
-	{
-		Row& row = rows[{r.factor, r.site}];
-		++row.pairs;
-		if (!r.merged)
-			++row.refused;
-		else if (r.outcome.right)
-			++row.right;
-		else
-			++row.wrong;
-	}
+	std::map<std::pair<double, std::string>, PairTally> rows;
+	for (const auto& r : runs) rows[{r.factor, r.site}].add(r.merged, r.outcome.right);
 	md << "\n## OTHER recorded as a coarser grid (Halmstad)\n\n"
 	   << "The sensor pairs above with OTHER resampled as a coarser robot would record it (a coarse cell is occupied "
 		  "if any fine cell in it is, else free if any is), cells ×factor larger, its stated resolution left at "

@@ -77,23 +77,9 @@ FloorPlanTotals floorPlanTotals(const std::vector<FloorPlanRun>& runs)
 
 void writeFloorPlanSection(std::ostream& md, const std::vector<FloorPlanRun>& runs)
 {
-	struct Row
-	{
-		size_t pairs = 0, right = 0, refused = 0, wrong = 0;
-	};
-	std::map<std::string, Row> rows;
+	std::map<std::string, PairTally> rows;
 	for (const auto& r : runs)
-		if (r.positive)
-		{
-			Row& row = rows[r.site];
-			++row.pairs;
-			if (!r.merged)
-				++row.refused;
-			else if (r.outcome.right)
-				++row.right;
-			else
-				++row.wrong;
-		}
+		if (r.positive) rows[r.site].add(r.merged, r.outcome.right);
 	md << "\n## Floor plans (Halmstad layouts)\n\n"
 	   << "Each sensor map (OTHER) placed on its building's floor plan (REF: the `layout` PNG saved for map_server as "
 		  "drawn, transparent outside = unknown), both stated at 0.05 m: the scale between them, 0.63–1.59, comes from "
@@ -103,7 +89,7 @@ void writeFloorPlanSection(std::ostream& md, const std::vector<FloorPlanRun>& ru
 	for (const auto& site : {"E5", "HIH", "F5", "KPT4A"})
 		if (rows.count(site))
 		{
-			const Row& r = rows[site];
+			const PairTally& r = rows[site];
 			md << "| " << site << " | " << (isCalibrationSite(site) ? "calibration" : "**acceptance**") << " | "
 			   << r.pairs << " | " << r.right << " | " << r.refused << " | " << r.wrong << " |\n";
 		}

@@ -45,6 +45,22 @@ struct HalmstadOutcome
 	bool right = false;  //!< both within the issue's bounds
 };
 
+/** Aligned pairs counted: merged right, refused, merged wrong. */
+struct PairTally
+{
+	size_t pairs = 0, right = 0, refused = 0, wrong = 0;
+	void add(bool merged, bool right_by_truth)
+	{
+		++pairs;
+		if (!merged)
+			++refused;
+		else if (right_by_truth)
+			++right;
+		else
+			++wrong;
+	}
+};
+
 class HalmstadData
 {
    public:
