@@ -89,7 +89,7 @@ std::optional<Similarity2D> bentRefit(
 	TsICPParams wide = p.icp;
 	wide.lambda = p.bent_lambda;
 	const Similarity2D refit = refineFromTheInside(ref, other, cells, wide).transform;
-	const Eigen::Vector2d centroid = wallCentroid(other);
+	const Eigen::Vector2d& centroid = other.wall_centroid;
 	// The decision judged `cells`: the refit moves it within its bends, never
 	// to a rival placement.
 	if (refit.isFinite() && refit.scale > 0 &&

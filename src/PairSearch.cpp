@@ -96,7 +96,7 @@ Aligner::TCandidate candidateOf(
 	cand.consistency = cell_consistency;
 	cand.evidence = j.evidence;
 	cand.score = j.score;
-	cand.other_centre = r.transform.apply(c.other_centroid);
+	cand.other_centre = r.transform.apply(c.other.wall_centroid);
 	return cand;
 }
 
@@ -127,7 +127,7 @@ Screen screenOne(const PairContext& c, const Hypothesis& h)
 
 bool onExactFound(const PairContext& c, const SearchState& state, const Similarity2D& t)
 {
-	const Placement at{t, t.apply(c.other_centroid)};
+	const Placement at{t, t.apply(c.other.wall_centroid)};
 	return std::any_of(state.exact_found.begin(), state.exact_found.end(), [&](const Aligner::TCandidate& e) {
 		return samePlacement(at, e.placement(), kSamePlacementCells, kSamePlacementTurnDeg, kSamePlacementScale);
 	});
@@ -274,7 +274,7 @@ PairContext makeContext(
 	stage_seconds["matches"] = clock.Tac();
 	std::optional<double> expected_scale;
 	if (options.use_resolution_metadata) expected_scale = other.resolution / ref.resolution;
-	return {ref, other, options, log, std::move(matches), wallCentroid(other), expected_scale, options.icpParams()};
+	return {ref, other, options, log, std::move(matches), expected_scale, options.icpParams()};
 }
 
 Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool in_full)

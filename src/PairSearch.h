@@ -27,7 +27,6 @@ struct PairContext
 	/** Feature matches of every pyramid level pair: RANSAC's input, and
 	 * evidence about each candidate (Evidence::feature_agreement). */
 	std::vector<LevelMatches> matches;
-	Eigen::Vector2d other_centroid{0, 0};  //!< wallCentroid(other): where a placement puts it
 	std::optional<double> expected_scale;  //!< with use_resolution_metadata
 	TsICPParams icp;
 

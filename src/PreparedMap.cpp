@@ -11,11 +11,15 @@ namespace multires_map_merge
 {
 namespace
 {
-/** The map's edge points and the k-d tree on them (none below 3 points). */
+/** The map's edge points, the k-d tree on them (none below 3 points) and
+ * their centroid. */
 void setEdges(PreparedMap& p, PointList edges)
 {
 	p.edges = std::move(edges);
 	p.edge_tree = p.edges.size() >= 3 ? std::make_shared<const PointKDTree>(p.edges) : nullptr;
+	Eigen::Vector2d sum(0, 0);
+	for (const auto& e : p.edges) sum += e;
+	p.wall_centroid = p.edges.empty() ? sum : Eigen::Vector2d(sum / double(p.edges.size()));
 }
 
 /** Share of `points` that `t` moves onto the target's known space. */
@@ -69,13 +73,6 @@ PreparedMapPtr mirroredMap(const PreparedMap& map)
 	cv::flip(map.field.known, p->field.known, 1);
 	p->features = features.get();
 	return p;
-}
-
-Eigen::Vector2d wallCentroid(const PreparedMap& map)
-{
-	Eigen::Vector2d centroid(0, 0);
-	for (const auto& p : map.edges) centroid += p;
-	return map.edges.empty() ? centroid : Eigen::Vector2d(centroid / double(map.edges.size()));
 }
 
 TsICPResult refineFromTheInside(

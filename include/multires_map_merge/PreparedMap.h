@@ -33,6 +33,9 @@ struct PreparedMap
 	/** On `edges`, built once: every hypothesis's TsICP moves one map's
 	 * edges, either map's (null with fewer than 3 edge points). */
 	std::shared_ptr<const PointKDTree> edge_tree;
+	/** The centroid of `edges` (cells): where a placement puts the map is
+	 * told apart by where this lands. */
+	Eigen::Vector2d wall_centroid{0, 0};
 	OccupancyField field;
 	std::map<std::string, double> stage_seconds;  //!< features, edges
 };
@@ -44,10 +47,6 @@ void describeMap(PreparedMap& map);
 
 /** The map with its x axis flipped, described (the aligner's mirror check). */
 PreparedMapPtr mirroredMap(const PreparedMap& map);
-
-/** The centroid of the map's edge points (cells): where a placement puts
- * the map is told apart by where this lands. */
-Eigen::Vector2d wallCentroid(const PreparedMap& map);
 
 /** TsICP from `start` (other → ref cells), with the map that lies more
  * inside the other as the fixed set (TsICP trims to the share of the fixed
