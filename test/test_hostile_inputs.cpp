@@ -1,4 +1,4 @@
-// Hostile inputs, one test each (README "Hostile inputs" lists them): every
+// Hostile inputs, one test each (docs/limits.md, "Hostile inputs", lists them): every
 // one ends in a clear error or a refusal to merge, never a crash, a hang or a
 // silent wrong merge. The OccupancyGrid message cases are in
 // test_merge_service.cpp and, on the node, test_merge_maps_node.cpp.

@@ -140,7 +140,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double metadata_scale_tolerance = 0.15;  //!< relative, with use_resolution_metadata
 		// --- Limits
 		/** Larger maps are refused before any work, so peak memory stays
-		 * bounded (README "Limits" states the bound per cell). */
+		 * bounded (docs/limits.md states the bound per cell). */
 		double max_map_cells = 32e6;
 
 		void loadFromConfigFile(
