@@ -159,3 +159,37 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 	EXPECT_FALSE(fs::exists("--png"));
 	EXPECT_FALSE(fs::exists(d + "/x.png"));
 }
+
+// An output that cannot be written stops the run before any map is loaded
+// or aligned (REF is not even announced), naming the option and the file.
+TEST(Cli, UnwritableOutputsExitTwoBeforeAnyWork)
+{
+	const std::string d = dir();
+	saveGridMap(malagaPair().ref, d + "/ok.gridmap.gz");
+	fs::create_directories(d + "/a_folder");
+	const std::string maps = d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz";
+	struct Bad
+	{
+		std::string args, words;
+	};
+	for (const Bad& b : {
+			 Bad{maps + " --out " + d + "/no/such/m.yaml", "--out '" + d + "/no/such/m.yaml': no folder"},
+			 Bad{maps + " --png " + d + "/no/x.png", "--png '" + d + "/no/x.png': no folder"},
+			 Bad{maps + " --json " + d + "/a_folder", "--json '" + d + "/a_folder': exists and is not a file"},
+			 Bad{maps + " --out " + d + "/a_folder.yaml --json " + d + "/r.json --png " + d + "/a_folder",
+				 "--png '" + d + "/a_folder': exists"},
+		 })
+	{
+		SCOPED_TRACE(b.args);
+		const CliRun r = runCli(b.args);
+		EXPECT_EQ(r.exit_code, 2) << r.output;
+		EXPECT_NE(r.output.find(b.words), std::string::npos) << r.output;
+		EXPECT_EQ(r.output.find("REF "), std::string::npos) << "loaded the maps first:\n" << r.output;
+	}
+	EXPECT_FALSE(fs::exists(d + "/a_folder.yaml"));
+	// The JSON that can be written says why nothing else was.
+	std::ifstream json(d + "/r.json");
+	const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+	EXPECT_NE(text.find("a_folder': exists and is not a file"), std::string::npos) << text;
+	EXPECT_FALSE(fs::exists(d + "/x.png"));
+}

@@ -21,6 +21,8 @@
 #include <fstream>
 #include <iostream>
 
+#include <unistd.h>  // access(): may this process write there
+
 using namespace multires_map_merge;
 
 namespace
@@ -87,6 +89,23 @@ std::vector<std::string> expandTopics(int argc, char** argv)
 			i += 2;
 		}
 	return args;
+}
+
+/** An output that cannot be written is found before the maps are loaded and
+ * aligned, not after: its folder must exist and be writable, and an existing
+ * file there must be a writable file. Nothing is created or truncated here. */
+void checkWritable(const std::string& option, const std::string& path)
+{
+	namespace fs = std::filesystem;
+	const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+	std::error_code ec;
+	if (!fs::is_directory(folder, ec))
+		throw UsageError("--" + option + " '" + path + "': no folder '" + folder.string() + "' to write into");
+	if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+		throw UsageError("--" + option + " '" + path + "': exists and is not a file");
+	const bool writable = fs::exists(path, ec) ? ::access(path.c_str(), W_OK) == 0
+											  : ::access(folder.c_str(), W_OK | X_OK) == 0;
+	if (!writable) throw UsageError("--" + option + " '" + path + "': cannot write there (permission denied)");
 }
 
 void writeText(const std::string& path, const std::string& text)
@@ -216,6 +235,10 @@ int main(int argc, char** argv)
 		if (out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".gridmap.gz") &&
 			!hasSuffix(out_arg.getValue(), ".gridmap") && !hasSuffix(out_arg.getValue(), ".yaml"))
 			throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
+		for (const auto* a : {&json_arg, &out_arg, &png_arg})
+			if (a->isSet()) checkWritable(a->getName(), a->getValue());
+		if (out_arg.isSet() && hasSuffix(out_arg.getValue(), ".yaml"))  // and its image beside it
+			checkWritable("out", std::filesystem::path(out_arg.getValue()).replace_extension(".pgm").string());
 
 		const Inputs in = bag_mode ? fromBag(bag_arg.getValue(), topics_arg.getValue())
 								   : fromFiles(maps_arg.getValue(), smres_arg.getValue());
