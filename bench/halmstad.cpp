@@ -113,9 +113,10 @@ std::string HalmstadData::yaml(const std::string& map, const std::string& dir) c
 {
 	fs::create_directories(dir);
 	const std::string path = dir + "/" + map + ".yaml";
-	if (!fs::exists(path))
-		std::ofstream(path) << "image: " << fs::absolute(png(map)).string() << "\nresolution: " << kHalmstadResolution
-							<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	// Written each time: what it says is the benchmark's, not a stale file's.
+	std::ofstream(path) << "image: " << fs::absolute(png(map)).string() << "\nresolution: " << kHalmstadResolution
+						<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+						<< (isSensorMap(map) ? "" : "floor_plan: true\n");
 	return path;
 }
 

@@ -233,10 +233,12 @@ std::string checkGrid(const COccupancyGridMap2D& g)
 }  // namespace
 
 
-CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COccupancyGridMap2D& grid) const
+CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(
+	const COccupancyGridMap2D& grid, MapKind kind) const
 {
 	auto p = std::make_shared<TPreparedMap>();
 	p->resolution = grid.getResolution();
+	p->kind = kind;
 	p->feature_params = options.featureParams();
 	if (!options.invalidReason().empty()) return p;  // alignScaled says why; nothing here is safe to run
 	if (std::string why = checkGrid(grid); !why.empty())
@@ -272,12 +274,18 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(const COc
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const COccupancyGridMap2D& ref, const COccupancyGridMap2D& other) const
 {
+	return alignGrids(ref, MapKind::Sensed, other, MapKind::Sensed);
+}
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignGrids(
+	const COccupancyGridMap2D& ref, MapKind ref_kind, const COccupancyGridMap2D& other, MapKind other_kind) const
+{
 	mrpt::system::CTicTac total;
 	// The two maps are independent: prepared at once (prepare logs nothing;
 	// OpenCV runs a parallel_for_ that finds its pool busy on the caller's
 	// thread). Most of that time is serial: distance field, edges, k-d tree.
-	auto other_prepared = std::async(std::launch::async, [&]() { return prepare(other); });
-	const PreparedMapPtr ref_map = prepare(ref), other_map = other_prepared.get();
+	auto other_prepared = std::async(std::launch::async, [&]() { return prepare(other, other_kind); });
+	const PreparedMapPtr ref_map = prepare(ref, ref_kind), other_map = other_prepared.get();
 	TReturnInfo info = alignScaled(*ref_map, *other_map);
 	for (const auto* p : {ref_map.get(), other_map.get()})
 		for (const auto& [name, seconds] : p->stage_seconds) info.stage_seconds[name] += seconds;
@@ -474,7 +482,7 @@ double CScalingGridMapAligner::mirrorPass(const TPreparedMap& ref, const TPrepar
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const GridInFrame& ref, const GridInFrame& other) const
 {
-	TReturnInfo info = alignScaled(ref.grid, other.grid);
+	TReturnInfo info = alignGrids(ref.grid, ref.kind, other.grid, other.kind);
 	info.metric = betweenMapFrames(ref, info.metric, other);
 	return info;
 }

@@ -74,7 +74,7 @@ PreparedMaps prepareAll(
 		const size_t k = todo[i];
 		try
 		{
-			out[k] = local.prepare(maps[k].grid);
+			out[k] = local.prepare(maps[k].grid, maps[k].kind);
 		}
 		catch (const std::exception& ex)  // out of memory, say: that map's pairs fail, the others go on
 		{

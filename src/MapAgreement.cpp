@@ -139,6 +139,15 @@ OccupancyField occupancyField(const cv::Mat& classes)
 	return f;
 }
 
+void claimedByDrawing(OccupancyField& field, const cv::Mat& classes)
+{
+	// What a plan leaves out of its building (grey, transparent) is drawn
+	// as empty: a wall there conflicts. Its white only vouches near walls.
+	const cv::Mat outside = classes == kUnknown;
+	field.known = (field.dist_to_occupied <= kPlanVouchesCells) | outside;
+	cv::distanceTransform(~outside, field.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+}
+
 cv::Mat knownWithin(const cv::Mat& known, double cells)
 {
 	const int r = std::max(1, int(std::ceil(cells)));

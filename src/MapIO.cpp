@@ -78,6 +78,7 @@ struct MapServerYaml
 	bool negate = false;
 	double occupied_thresh = 0.65, free_thresh = 0.196;
 	MapServerMode mode = MapServerMode::trinary;
+	bool floor_plan = false;  // ours, beside map_server's keys (which it ignores)
 };
 
 // A map_server YAML is a few hundred bytes; the limit keeps the parser away
@@ -139,6 +140,13 @@ MapServerYaml readMapServerYaml(const std::string& path)
 			y.negate = b;
 		else
 			y.negate = number("negate", n) != 0;
+	}
+	if (doc["floor_plan"])
+	{
+		bool b = false;
+		if (!YAML::convert<bool>::decode(scalar("floor_plan"), b))
+			fail(path, "'floor_plan' must be true or false, not '" + scalar("floor_plan").Scalar() + "'");
+		y.floor_plan = b;
 	}
 	if (doc["occupied_thresh"]) y.occupied_thresh = number("occupied_thresh", scalar("occupied_thresh"));
 	if (doc["free_thresh"]) y.free_thresh = number("free_thresh", scalar("free_thresh"));
@@ -246,6 +254,7 @@ GridInFrame loadMapServerYaml(const std::string& path)
 
 	GridInFrame map;
 	map.origin = Similarity2D(1, y.origin[2], {y.origin[0], y.origin[1]});
+	map.kind = y.floor_plan ? MapKind::FloorPlan : MapKind::Sensed;
 	COccupancyGridMap2D& g = map.grid;
 	g.setSize(0, float(img.cols * y.resolution), 0, float(img.rows * y.resolution), float(y.resolution), 0.5f);
 	if (int(g.getSizeX()) != img.cols || int(g.getSizeY()) != img.rows)

@@ -274,7 +274,21 @@ PairContext makeContext(
 	stage_seconds["matches"] = clock.Tac();
 	std::optional<double> expected_scale;
 	if (options.use_resolution_metadata) expected_scale = other.resolution / ref.resolution;
-	return {ref, other, options, log, std::move(matches), expected_scale, options.icpParams()};
+	auto judged = [](const PreparedMap& map, const PreparedMap& against) {
+		PointList points = map.edges;
+		if (against.kind == MapKind::FloorPlan && map.kind != MapKind::FloorPlan)
+			points.insert(points.end(), map.free_sample.begin(), map.free_sample.end());
+		return points;
+	};
+	return {ref,
+			other,
+			options,
+			log,
+			std::move(matches),
+			expected_scale,
+			options.icpParams(),
+			judged(ref, other),
+			judged(other, ref)};
 }
 
 Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool in_full)
@@ -282,11 +296,11 @@ Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool i
 	const auto& o = c.options;
 	const PointList &ref_edges = c.ref.edges, &other_edges = c.other.edges;
 	Judgement j;
-	const TwoWaySupport sup =
-		twoWaySupport(ref_edges, c.ref.field, other_edges, c.other.field, t, o.verify_tolerance, most, in_full);
+	const TwoWaySupport sup = twoWaySupport(
+		c.ref_judged, c.ref.field, c.other_judged, c.other.field, t, o.verify_tolerance, most, in_full);
 	const Chance chance = chanceSupport(
-		ref_edges, c.ref.field, other_edges, c.other.field, t, o.verify_tolerance, o.verify_shift, o.verify_turn_deg,
-		most);
+		c.ref_judged, c.ref.field, c.other_judged, c.other.field, t, o.verify_tolerance, o.verify_shift,
+		o.verify_turn_deg, most);
 	j.bends = twoWayShiftField(ref_edges, c.ref.field, other_edges, c.other.field, t, o.verify_tolerance, most);
 	// The count a full judgement would take, from a sample's.
 	auto full = [&](size_t judged, size_t n) {
@@ -302,7 +316,7 @@ Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool i
 	e.shift_coherence = j.bends.coherence();
 	e.feature_agreement = double(agreeingMatches(c.matches, t));
 	e.judged_points = std::min(
-		full(sup.other_in_ref.judged, other_edges.size()), full(sup.ref_in_other.judged, ref_edges.size()));
+		full(sup.other_in_ref.judged, c.other_judged.size()), full(sup.ref_in_other.judged, c.ref_judged.size()));
 	j.score = o.decision.score(e);
 	return j;
 }

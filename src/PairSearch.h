@@ -29,6 +29,9 @@ struct PairContext
 	std::vector<LevelMatches> matches;
 	std::optional<double> expected_scale;  //!< with use_resolution_metadata
 	TsICPParams icp;
+	/** The points each map is judged on: its walls, and against a floor plan
+	 * also a sample of its free space (a plan says where the building is). */
+	PointList ref_judged, other_judged;
 
 	/** A finite transform at a scale allowed (use_resolution_metadata). */
 	bool usable(const Similarity2D& t) const;

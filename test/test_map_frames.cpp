@@ -175,6 +175,8 @@ TEST(MapFrames, BadYamlNamesTheFileAndTheKey)
 		{"origin_short", "image: ok.pgm\nresolution: 0.05\norigin: [1]\n" + good_tail, "'origin'"},
 		{"origin_yaw_text", "image: ok.pgm\nresolution: 0.05\norigin: [0, 0, north]\n" + good_tail, "'origin'"},
 		{"negate_text", "image: ok.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: maybe\n", "'negate'"},
+		{"floor_plan_text", "image: ok.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nfloor_plan: perhaps\n" + good_tail,
+		 "'floor_plan' must be true or false"},
 		{"mode_bad", "image: ok.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nmode: fancy\n" + good_tail, "'mode'"},
 		{"thresh_range", "image: ok.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 65\n",
 		 "'occupied_thresh'"},

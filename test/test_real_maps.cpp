@@ -172,6 +172,21 @@ TEST(RealMaps, HalmstadDifferentBuildingsAreRefused)
 	expectRefused("E5_14", "HIH_03");
 }
 
+// A robot's map on its building's floor plan (map_server files saying
+// floor_plan: true), the scale (0.82 / 1.22) from the content, the plan in
+// either role; a plan of another building refused, though its large empty
+// rooms leave most of the robot's walls unjudged.
+TEST(RealMaps, HalmstadRobotMapsPlacedOnTheFloorPlan)
+{
+	REQUIRE_HALMSTAD();
+	ASSERT_EQ(loadGridMap(halmstad()->yaml("E5_layout", dir())).kind, MapKind::FloorPlan);
+	ASSERT_EQ(loadGridMap(halmstad()->yaml("E5_03", dir())).kind, MapKind::Sensed);
+	expectMergedRight("E5_layout", "E5_03");
+	expectMergedRight("E5_07", "E5_layout");
+	expectRefused("KPT4A_layout", "E5_14");
+	expectRefused("F5_layout", "E5_07");
+}
+
 TEST(RealMaps, HalmstadMirroredMapIsRefused)
 {
 	REQUIRE_HALMSTAD();

@@ -251,8 +251,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	using PreparedMapPtr = multires_map_merge::PreparedMapPtr;
 
 	/** Prepares one map with these options. Never throws on bad content:
-	 * the map's `problem` says what is wrong. */
-	PreparedMapPtr prepare(const mrpt::maps::COccupancyGridMap2D& grid) const;
+	 * the map's `problem` says what is wrong. A floor plan (MapKind) is
+	 * judged only near its walls. */
+	PreparedMapPtr prepare(const mrpt::maps::COccupancyGridMap2D& grid, MapKind kind = MapKind::Sensed) const;
 
 	/** The full similarity between two grids. Never throws on bad map
 	 * content: the reason is in TReturnInfo::message with success = false. */
@@ -275,7 +276,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	/** The same for maps held in their exact frames (map_server files, ROS
 	 * messages; MapIO, OccupancyGridConversion): TReturnInfo::metric is then
 	 * between the *maps'* frames (x_ref_map = metric(x_other_map)), exact for
-	 * any origin; `cells` is unchanged. */
+	 * any origin; `cells` is unchanged. Either may be a floor plan
+	 * (GridInFrame::kind). */
 	TReturnInfo alignScaled(const GridInFrame& ref, const GridInFrame& other) const;
 
 	/** MRPT interface. m1 = reference, m2 = other, both COccupancyGridMap2D.
@@ -294,6 +296,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		mrpt::optional_ref<mrpt::slam::TMetricMapAlignmentResult> outInfo = std::nullopt) override;
 
    private:
+	TReturnInfo alignGrids(
+		const mrpt::maps::COccupancyGridMap2D& ref, MapKind ref_kind, const mrpt::maps::COccupancyGridMap2D& other,
+		MapKind other_kind) const;
 	/** The search, decision and finish of one pair (a given start first). */
 	TReturnInfo align(
 		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;

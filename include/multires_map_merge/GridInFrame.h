@@ -13,6 +13,15 @@
 
 namespace multires_map_merge
 {
+/** What a map's free space says. A robot's map saw its free space; a floor
+ * plan drew it: furniture it does not draw and walls a robot never saw are
+ * not evidence against an alignment (MapAgreement.h, claimedByDrawing). */
+enum class MapKind
+{
+	Sensed,
+	FloorPlan
+};
+
 struct GridInFrame
 {
 	mrpt::maps::COccupancyGridMap2D grid;  //!< metres in its own (origin) frame
@@ -20,6 +29,8 @@ struct GridInFrame
 	 * map_server `origin`, a message's `info.origin`). Identity for .gridmap
 	 * files, whose frame is the grid's own. */
 	Similarity2D origin;
+	/** A map_server file says `floor_plan: true` for a drawn plan. */
+	MapKind kind = MapKind::Sensed;
 
 	/** Cell coordinates (cell centres at integers) → the map's frame. */
 	Similarity2D cellToMapFrame() const { return origin.compose(cellToMetric(grid)); }

@@ -51,6 +51,19 @@ struct OccupancyField
 constexpr uint8_t kNoDirection = 255;
 OccupancyField occupancyField(const cv::Mat& classes);
 
+/** How far from its walls a floor plan vouches for its space (plan cells):
+ * the drawn line, its anti-aliased fringe and the wall's thickness, which
+ * the line stands for. Farther inside, a plan's white is drawn, not seen:
+ * furniture there is no conflict. One number, chosen on the calibration
+ * sites' plans (E5, HIH; docs/decision.md). */
+constexpr double kPlanVouchesCells = 3.0;
+
+/** A floor plan's field (from its `classes`): inside the building only the
+ * space within kPlanVouchesCells of its walls is known, so furniture on its
+ * white judges nothing; what it leaves outside the building counts as seen
+ * empty, so a wall there conflicts. */
+void claimedByDrawing(OccupancyField& field, const cv::Mat& classes);
+
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
  * the edge of what a map saw lie just outside its known space. */
 cv::Mat knownWithin(const cv::Mat& known, double cells);

@@ -5,6 +5,7 @@
 // takes part in several pairs: prepare it once, align it in each.
 
 #include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/MapAgreement.h>
 #include <multires_map_merge/PointKDTree.h>
 #include <multires_map_merge/Similarity2D.h>
@@ -24,6 +25,7 @@ struct PreparedMap
 	/** Why this map cannot be aligned, after "reference map " or "other
 	 * map " ("" when it can): no structure, too small or too large. */
 	std::string problem;
+	MapKind kind = MapKind::Sensed;  //!< a floor plan's field claims only its walls
 	double resolution = 0;  //!< as stated
 	Similarity2D cell_to_metric;  //!< the grid's cells → its metric frame
 	cv::Mat classes;  //!< GridImage.h
@@ -37,6 +39,9 @@ struct PreparedMap
 	 * told apart by where this lands. */
 	Eigen::Vector2d wall_centroid{0, 0};
 	OccupancyField field;
+	/** Free cells, one in about as many as leave half as many points as
+	 * `edges`: judged against a floor plan's outside. */
+	PointList free_sample;
 	std::map<std::string, double> stage_seconds;  //!< features, edges
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
