@@ -128,24 +128,26 @@ Agreement mapAgreement(
 	return a;
 }
 
-OccupancyField occupancyField(const cv::Mat& classes)
+OccupancyField occupancyField(const cv::Mat& classes, MapKind kind)
 {
 	OccupancyField f;
 	cv::distanceTransform(classes != kOccupied, f.dist_to_occupied, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-	cv::distanceTransform(classes == kFree, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-	f.known = classes != kUnknown;
+	if (kind == MapKind::Sensed)
+	{
+		cv::distanceTransform(classes == kFree, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+		f.known = classes != kUnknown;
+	}
+	else
+	{
+		// What a plan leaves out of its building (grey, transparent) is drawn
+		// as empty: a wall there conflicts. Its white only vouches near walls.
+		const cv::Mat outside = classes == kUnknown;
+		cv::distanceTransform(~outside, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+		f.known = (f.dist_to_occupied <= kPlanVouchesCells) | outside;
+	}
 	const cv::Mat occupied = classes == kOccupied;
 	f.wall_normal_deg = wallNormals(occupied);
 	return f;
-}
-
-void claimedByDrawing(OccupancyField& field, const cv::Mat& classes)
-{
-	// What a plan leaves out of its building (grey, transparent) is drawn
-	// as empty: a wall there conflicts. Its white only vouches near walls.
-	const cv::Mat outside = classes == kUnknown;
-	field.known = (field.dist_to_occupied <= kPlanVouchesCells) | outside;
-	cv::distanceTransform(~outside, field.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 }
 
 cv::Mat knownWithin(const cv::Mat& known, double cells)

@@ -1,5 +1,6 @@
 #include "PairSearch.h"
 
+#include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/MapAgreement.h>
 #include <multires_map_merge/StructureHypotheses.h>
 
@@ -256,6 +257,31 @@ bool record(const PairContext& c, SearchState& state, const Hypothesis& h, const
 	if (!cand.screened && cand.evidence.exact_confidence >= d.min_confidence) state.exact_found.push_back(cand);
 	return d.mergedWhateverComes(decisionInput(cand), kExactEnough) && !c.options.exhaustive_search;
 }
+
+/** Free cells of `classes` on a lattice whose stride leaves about `most`. */
+PointList freeSample(const cv::Mat& classes, size_t most)
+{
+	const double free = cv::countNonZero(classes == kFree);
+	PointList out;
+	if (most == 0 || free == 0) return out;
+	const int stride = std::max(1, int(std::ceil(std::sqrt(free / double(most)))));
+	for (int y = 0; y < classes.rows; y += stride)
+		for (int x = 0; x < classes.cols; x += stride)
+			if (classes.at<uint8_t>(y, x) == kFree) out.emplace_back(x, y);
+	return out;
+}
+
+/** A robot map judged against a floor plan: its walls, and free cells as
+ * many as half its walls (a plan's outside conflicts with them). Empty for
+ * any other pair: the map is judged on its walls alone. */
+PointList wallsAndFreeAgainstPlan(const PreparedMap& map, const PreparedMap& against)
+{
+	if (against.kind != MapKind::FloorPlan || map.kind == MapKind::FloorPlan) return {};
+	PointList points = map.edges;
+	const PointList free = freeSample(map.classes, map.edges.size() / 2);
+	points.insert(points.end(), free.begin(), free.end());
+	return points;
+}
 }  // namespace
 
 bool PairContext::usable(const Similarity2D& t) const
@@ -274,12 +300,6 @@ PairContext makeContext(
 	stage_seconds["matches"] = clock.Tac();
 	std::optional<double> expected_scale;
 	if (options.use_resolution_metadata) expected_scale = other.resolution / ref.resolution;
-	auto judged = [](const PreparedMap& map, const PreparedMap& against) {
-		PointList points = map.edges;
-		if (against.kind == MapKind::FloorPlan && map.kind != MapKind::FloorPlan)
-			points.insert(points.end(), map.free_sample.begin(), map.free_sample.end());
-		return points;
-	};
 	return {ref,
 			other,
 			options,
@@ -287,8 +307,8 @@ PairContext makeContext(
 			std::move(matches),
 			expected_scale,
 			options.icpParams(),
-			judged(ref, other),
-			judged(other, ref)};
+			wallsAndFreeAgainstPlan(ref, other),
+			wallsAndFreeAgainstPlan(other, ref)};
 }
 
 Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool in_full)
@@ -297,9 +317,9 @@ Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool i
 	const PointList &ref_edges = c.ref.edges, &other_edges = c.other.edges;
 	Judgement j;
 	const TwoWaySupport sup = twoWaySupport(
-		c.ref_judged, c.ref.field, c.other_judged, c.other.field, t, o.verify_tolerance, most, in_full);
+		c.refJudged(), c.ref.field, c.otherJudged(), c.other.field, t, o.verify_tolerance, most, in_full);
 	const Chance chance = chanceSupport(
-		c.ref_judged, c.ref.field, c.other_judged, c.other.field, t, o.verify_tolerance, o.verify_shift,
+		c.refJudged(), c.ref.field, c.otherJudged(), c.other.field, t, o.verify_tolerance, o.verify_shift,
 		o.verify_turn_deg, most);
 	j.bends = twoWayShiftField(ref_edges, c.ref.field, other_edges, c.other.field, t, o.verify_tolerance, most);
 	// The count a full judgement would take, from a sample's.
@@ -316,7 +336,7 @@ Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool i
 	e.shift_coherence = j.bends.coherence();
 	e.feature_agreement = double(agreeingMatches(c.matches, t));
 	e.judged_points = std::min(
-		full(sup.other_in_ref.judged, c.other_judged.size()), full(sup.ref_in_other.judged, c.ref_judged.size()));
+		full(sup.other_in_ref.judged, c.otherJudged().size()), full(sup.ref_in_other.judged, c.refJudged().size()));
 	j.score = o.decision.score(e);
 	return j;
 }

@@ -29,10 +29,17 @@ struct PairContext
 	std::vector<LevelMatches> matches;
 	std::optional<double> expected_scale;  //!< with use_resolution_metadata
 	TsICPParams icp;
-	/** The points each map is judged on: its walls, and against a floor plan
-	 * also a sample of its free space (a plan says where the building is). */
-	PointList ref_judged, other_judged;
+	/** A robot map's walls and a sample of its free space, only when the
+	 * other map is a floor plan (a plan says where the building is). */
+	PointList ref_walls_and_free, other_walls_and_free;
 
+	/** The points each map is judged on: its walls, and against a floor
+	 * plan also a sample of its free space. */
+	const PointList& refJudged() const { return ref_walls_and_free.empty() ? ref.edges : ref_walls_and_free; }
+	const PointList& otherJudged() const
+	{
+		return other_walls_and_free.empty() ? other.edges : other_walls_and_free;
+	}
 	/** A finite transform at a scale allowed (use_resolution_metadata). */
 	bool usable(const Similarity2D& t) const;
 };

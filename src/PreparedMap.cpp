@@ -33,18 +33,6 @@ double shareOnKnown(const PointList& points, const Similarity2D& t, const Occupa
 }
 }  // namespace
 
-PointList freeSample(const cv::Mat& classes, size_t most)
-{
-	const double free = cv::countNonZero(classes == kFree);
-	PointList out;
-	if (most == 0 || free == 0) return out;
-	const int stride = std::max(1, int(std::ceil(std::sqrt(free / double(most)))));
-	for (int y = 0; y < classes.rows; y += stride)
-		for (int x = 0; x < classes.cols; x += stride)
-			if (classes.at<uint8_t>(y, x) == kFree) out.emplace_back(x, y);
-	return out;
-}
-
 void describeMap(PreparedMap& p)
 {
 	mrpt::system::CTicTac stage;
@@ -54,9 +42,7 @@ void describeMap(PreparedMap& p)
 	// Edge points, and what the verification judges them against.
 	stage.Tic();
 	setEdges(p, edgePoints(p.classes));
-	p.field = occupancyField(p.classes);
-	if (p.kind == MapKind::FloorPlan) claimedByDrawing(p.field, p.classes);
-	p.free_sample = freeSample(p.classes, p.edges.size() / 2);
+	p.field = occupancyField(p.classes, p.kind);
 	p.stage_seconds["edges"] += stage.Tac();
 }
 
@@ -87,7 +73,6 @@ PreparedMapPtr mirroredMap(const PreparedMap& map)
 	cv::flip(map.field.dist_to_not_free, p->field.dist_to_not_free, 1);
 	cv::flip(map.field.known, p->field.known, 1);
 	p->features = features.get();
-	p->free_sample = freeSample(p->classes, p->edges.size() / 2);
 	return p;
 }
 

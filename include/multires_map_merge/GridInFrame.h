@@ -15,7 +15,7 @@ namespace multires_map_merge
 {
 /** What a map's free space says. A robot's map saw its free space; a floor
  * plan drew it: furniture it does not draw and walls a robot never saw are
- * not evidence against an alignment (MapAgreement.h, claimedByDrawing). */
+ * not evidence against an alignment (MapAgreement.h, occupancyField). */
 enum class MapKind
 {
 	Sensed,

@@ -4,6 +4,7 @@
 // map across free space of the other, which point distances alone can hide
 // when both maps have many similar walls.
 
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/Similarity2D.h>
 #include <multires_map_merge/TsICP.h>
 
@@ -49,7 +50,6 @@ struct OccupancyField
 	cv::Mat wall_normal_deg;
 };
 constexpr uint8_t kNoDirection = 255;
-OccupancyField occupancyField(const cv::Mat& classes);
 
 /** How far from its walls a floor plan vouches for its space (plan cells):
  * the drawn line, its anti-aliased fringe and the wall's thickness, which
@@ -58,11 +58,12 @@ OccupancyField occupancyField(const cv::Mat& classes);
  * sites' plans (E5, HIH; docs/decision.md). */
 constexpr double kPlanVouchesCells = 3.0;
 
-/** A floor plan's field (from its `classes`): inside the building only the
- * space within kPlanVouchesCells of its walls is known, so furniture on its
- * white judges nothing; what it leaves outside the building counts as seen
- * empty, so a wall there conflicts. */
-void claimedByDrawing(OccupancyField& field, const cv::Mat& classes);
+/** The field of a map's `classes`. A robot's map (Sensed) knows what it
+ * saw. A floor plan's field: inside the building only the space within
+ * kPlanVouchesCells of its walls is known, so furniture on its white judges
+ * nothing; what it leaves outside the building counts as seen empty, so a
+ * wall there conflicts. */
+OccupancyField occupancyField(const cv::Mat& classes, MapKind kind = MapKind::Sensed);
 
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
  * the edge of what a map saw lie just outside its known space. */

@@ -39,9 +39,6 @@ struct PreparedMap
 	 * told apart by where this lands. */
 	Eigen::Vector2d wall_centroid{0, 0};
 	OccupancyField field;
-	/** Free cells, one in about as many as leave half as many points as
-	 * `edges`: judged against a floor plan's outside. */
-	PointList free_sample;
 	std::map<std::string, double> stage_seconds;  //!< features, edges
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
