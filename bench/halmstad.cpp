@@ -4,6 +4,7 @@
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -118,6 +119,47 @@ std::string HalmstadData::yaml(const std::string& map, const std::string& dir) c
 						<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
 						<< (isSensorMap(map) ? "" : "floor_plan: true\n");
 	return path;
+}
+
+/** The sensor map's PNG (0 occupied, 127 unknown, 255 free) recorded with
+ * cells `factor` times larger, as a map_server file stated at 0.05 m. */
+std::string coarserYaml(const HalmstadData& data, const std::string& map, double factor, const std::string& dir)
+{
+	std::ostringstream name;
+	name << map << "_x" << factor;
+	const std::string yaml = dir + "/" + name.str() + ".yaml";
+	if (fs::exists(yaml)) return yaml;
+	const cv::Mat fine = cv::imread(data.png(map), cv::IMREAD_GRAYSCALE);
+	if (fine.empty()) throw std::runtime_error("'" + data.png(map) + "': cannot read");
+	const int rows = int(std::ceil(fine.rows / factor)), cols = int(std::ceil(fine.cols / factor));
+	cv::Mat occupied(rows, cols, CV_8U, cv::Scalar(0)), free(rows, cols, CV_8U, cv::Scalar(0));
+	for (int v = 0; v < fine.rows; ++v)
+		for (int u = 0; u < fine.cols; ++u)
+		{
+			// Coarse cell j spans fine cells [j·factor, (j+1)·factor).
+			const int cv = std::min(rows - 1, int(v / factor)), cu = std::min(cols - 1, int(u / factor));
+			const uint8_t p = fine.at<uint8_t>(v, u);
+			if (p < 64) occupied.at<uint8_t>(cv, cu) = 1;
+			else if (p > 191) free.at<uint8_t>(cv, cu) = 1;
+		}
+	cv::Mat coarse(rows, cols, CV_8U, cv::Scalar(127));
+	coarse.setTo(255, free);
+	coarse.setTo(0, occupied);
+	fs::create_directories(dir);
+	const std::string pgm = dir + "/" + name.str() + ".pgm";
+	if (!cv::imwrite(pgm, coarse)) throw std::runtime_error("'" + pgm + "': cannot write");
+	std::ofstream(yaml) << "image: " << fs::path(pgm).filename().string() << "\nresolution: " << kHalmstadResolution
+						<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	return yaml;
+}
+
+/** The fine map's frame into the coarse map's (both read at 0.05 m, origin
+ * 0, +y up from the bottom row): x / factor, and y measured from the top
+ * edge, which both share. */
+Similarity2D fineToCoarse(double factor, int fine_rows, int coarse_rows)
+{
+	const double r = kHalmstadResolution;
+	return Similarity2D(1 / factor, 0, {0, (coarse_rows - fine_rows / factor) * r});
 }
 
 Similarity2D truthBetweenMapFrames(const HalmstadPair& p, int src_rows, int dst_rows)

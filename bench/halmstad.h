@@ -88,6 +88,16 @@ class HalmstadData
 	std::map<std::pair<std::string, std::string>, HalmstadPair> pairs_;
 };
 
+/** The sensor map's PNG (0 occupied, 127 unknown, 255 free) recorded with
+ * cells `factor` times larger (a coarse cell occupied if any fine cell is,
+ * else free if any is), as a map_server file in `dir` stated at 0.05 m:
+ * wrong metadata, as a coarser robot's map read at a fine map's resolution. */
+std::string coarserYaml(const HalmstadData& data, const std::string& map, double factor, const std::string& dir);
+
+/** The fine map's frame into its coarser recording's (both read at 0.05 m,
+ * origin 0): what turns a transform of the coarse map into the fine one's. */
+Similarity2D fineToCoarse(double factor, int fine_rows, int coarse_rows);
+
 /** Judges a transform between the maps' frames (x_ref = est(x_other); REF =
  * dst, OTHER = src, both loaded from the yamls) against the annotation:
  * mean displacement ≤ 40 px and correspondence RMS ≤ max(2·rms_px, 40 px). */

@@ -44,6 +44,7 @@
 #include "coarser_other.h"
 #include "floor_plans.h"
 #include "halmstad.h"
+#include "halmstad_fleets.h"
 #include "live_fleet.h"
 #include "mrpt_anchor.h"
 #include "plots.h"
@@ -572,19 +573,40 @@ int fleetChild(const std::string& dir)
 	for (int i = 0; fs::exists(dir + "/map_" + std::to_string(i) + ".yaml"); ++i)
 		maps.push_back(loadGridMap(dir + "/map_" + std::to_string(i) + ".yaml"));
 	mrpt::system::CTicTac clock;
-	const FleetResult r = placeFleet(maps, 0, benchAligner());
+	const FleetParams fp;
+	const FleetResult r = placeFleet(maps, 0, benchAligner(), fp);
 	const double placing = clock.Tac();
 	const FusedFleet fused = fuseFleet(maps, r, 0, maps[0].grid.getResolution());
 	const double seconds = clock.Tac();
 	std::cout << std::setprecision(12) << "FLEET " << seconds << " " << r.pairs_aligned << " " << r.pairs_skipped << " "
 			  << peakRssMb() << " " << placing << std::endl;
-	for (size_t i = 0; i < r.maps.size(); ++i)
-	{
-		const auto& p = r.maps[i].in_reference;
-		std::cout << "MAP " << i << " " << r.maps[i].placed << " " << p.scale << " " << p.yaw << " " << p.t.x() << " "
-				  << p.t.y() << std::endl;
-	}
+	size_t confident = 0, dropped = 0;
+	for (const auto& e : r.edges) confident += e.merged, dropped += e.merged && e.dropped;
+	std::cout << "EDGES " << confident << " " << dropped << std::endl;
+	// The same pairs placed by the spanning tree alone, for the report's "tree alone".
+	FleetParams tree_only = fp;
+	tree_only.joint_refinement = false;
+	const FleetResult tree = placeFromPairs(maps, 0, r.edges, tree_only);
+	for (const auto& [tag, result] : {std::pair("MAP", &r), std::pair("TREE", &tree)})
+		for (size_t i = 0; i < result->maps.size(); ++i)
+		{
+			const auto& p = result->maps[i].in_reference;
+			std::cout << tag << " " << i << " " << result->maps[i].placed << " " << p.scale << " " << p.yaw << " "
+					  << p.t.x() << " " << p.t.y() << std::endl;
+		}
 	return 0;
+}
+
+/** Places the fleet map_0.yaml, map_1.yaml, … of `dir` in a fresh process
+ * (fleetChild); returns the file holding what it printed. */
+std::string placeFleetInChild(const std::string& self, const std::string& dir)
+{
+	const std::string out = dir + "/out.txt";
+	const pid_t pid = spawnSelf({self, "--fleet-child", dir}, out);
+	if (pid < 0) throw std::runtime_error("cannot start " + self);
+	int status = 0;
+	waitpid(pid, &status, 0);
+	return out;
 }
 
 /** A fleet of `n` robots of fr079, each a 40 % share of the run spread over
@@ -633,11 +655,7 @@ FleetCase runFleetCase(const std::string& self, const std::string& name, int n, 
 			num(r * 100, 1) + " cm" + (beyond ? " (beyond the reference)" : other ? " (another building)" : "");
 		written.push_back(loadGridMap((dir / ("map_" + std::to_string(i) + ".yaml")).string()));
 	}
-	const std::string out = (dir / "out.txt").string();
-	const pid_t pid = spawnSelf({self, "--fleet-child", dir.string()}, out);
-	if (pid < 0) throw std::runtime_error("cannot start " + self);
-	int status = 0;
-	waitpid(pid, &status, 0);
+	const std::string out = placeFleetInChild(self, dir.string());
 	std::ifstream f(out);
 	double worst = 0;
 	for (std::string line; std::getline(f, line);)
@@ -1116,6 +1134,9 @@ int main(int argc, char** argv)
 		"", "sets", "only these accuracy sets (resolution, other-logs, rotation), printing their medians", false, "",
 		"SETS", cmd);
 	TCLAP::SwitchArg fleet_arg("", "fleet-only", "only the fleet section (printed as markdown)", cmd);
+	TCLAP::ValueArg<std::string> halmstad_fleets_arg(
+		"", "halmstad-fleets-only", "only the Halmstad fleets, same and mixed cell sizes, of these sites (e.g. F5,HIH)",
+		false, "", "SITES", cmd);
 	TCLAP::ValueArg<int> scaling_arg(
 		"", "scaling-only", "only the scaling case of this many cells a side (e.g. 4000)", false, 0, "CELLS", cmd);
 	TCLAP::SwitchArg live_arg(
@@ -1244,6 +1265,20 @@ int main(int argc, char** argv)
 			runScalingCase(fs::canonical("/proc/self/exe"), scaling_arg.getValue());
 			return 0;
 		}
+		if (halmstad_fleets_arg.isSet())
+		{
+			std::vector<std::string> sites;
+			std::stringstream list(halmstad_fleets_arg.getValue());
+			for (std::string site; std::getline(list, site, ',');) sites.push_back(site);
+			const std::string dir = (fs::temp_directory_path() / ("multires_bench_fleets_" + std::to_string(getpid()))).string();
+			const std::string self = fs::canonical("/proc/self/exe");
+			const auto runs = runHalmstadFleets(
+				HalmstadData(g_data + "/halmstad"), sites, true, [&](const std::string& d) { return placeFleetInChild(self, d); },
+				dir);
+			fs::remove_all(dir);
+			writeHalmstadFleetSection(std::cout, runs);
+			return 0;
+		}
 		if (fleet_arg.isSet())
 		{
 			writeFleetSection(std::cout, runFleets(fs::canonical("/proc/self/exe"), quick));
@@ -1319,6 +1354,16 @@ int main(int argc, char** argv)
 
 		// 4b. Fleets: N maps into one (fresh process each).
 		const std::vector<FleetCase> fleets = runFleets(fs::canonical("/proc/self/exe"), quick);
+		std::vector<HalmstadFleetRun> halmstad_fleets;
+		if (!quick)
+		{
+			const std::string dir = (fs::temp_directory_path() / ("multires_bench_fleets_" + std::to_string(getpid()))).string();
+			const std::string self = fs::canonical("/proc/self/exe");
+			const HalmstadData data(g_data + "/halmstad");
+			halmstad_fleets = runHalmstadFleets(
+				data, data.sites(), true, [&](const std::string& d) { return placeFleetInChild(self, d); }, dir);
+			fs::remove_all(dir);
+		}
 		const LiveLatency live = runLiveLatency(scansOf, quick ? 4 : 16);
 
 		// 5. Basin of convergence of TsICP alone.
@@ -1645,6 +1690,7 @@ int main(int argc, char** argv)
 			return std::count_if(b.begin(), b.end(), [](auto& c) { return c.converged; });
 		};
 		writeFleetSection(md, fleets);
+		if (!halmstad_fleets.empty()) writeHalmstadFleetSection(md, halmstad_fleets);
 		writeLiveSection(md, live);
 
 		md << "\n## Basin of convergence of TsICP alone (Fig. 7 analogue)\n\n"
@@ -1694,6 +1740,19 @@ int main(int argc, char** argv)
 					   c.placed_right == c.building && c.others_placed == 0);
 			if (c.name.find("1000×1000") != std::string::npos)
 				target("fleet of 8 maps of 1000×1000 cells in ≤ 3 s on 2 cores", num(c.seconds, 1) + " s", c.seconds <= 3);
+		}
+		for (const auto& f : halmstad_fleets)
+		{
+			const std::string name = "Halmstad fleet " + f.site + (f.mixed_cells ? " (mixed cells)" : "");
+			if (f.maps >= 14)
+				target(name + " of " + std::to_string(f.maps) + " maps in one call: ≤ 10 s, ≤ 2 GiB peak",
+					   num(f.seconds, 1) + " s, " + num(f.peak_mb, 0) + " MB", f.seconds <= 10 && f.peak_mb <= 2048);
+			const auto& d = f.joint.displacement_px;
+			const double med = median(d), worst = d.empty() ? NAN : *std::max_element(d.begin(), d.end());
+			target(name + ": every map placed right, displacement median ≤ 7 px, max ≤ 15 px",
+				   std::to_string(f.joint.right) + " / " + std::to_string(f.maps - 1) + ", median " + num(med, 1) +
+					   " px, max " + num(worst, 1) + " px",
+				   f.joint.right + 1 == f.maps && med <= 7 && worst <= 15);
 		}
 		{
 			const double worst = live.maxLatencySeconds();

@@ -222,7 +222,7 @@ int main(int argc, char** argv)
 						pose << " [" << s.world_frame << " -> " << r.frame_id << ": x " << r.in_world.t.x() << " m, y "
 							 << r.in_world.t.y() << " m, yaw " << r.in_world.yaw * 180 / M_PI << " deg, scale "
 							 << r.in_world.scale << "]"
-							 << (std::abs(r.in_world.scale - 1) > 1e-3 ? " (its stated resolution is off; TF carries the rigid part)" : "");
+							 << (r.stated_resolution_off ? " (its stated resolution is off; TF carries the rigid part)" : "");
 					ROS_INFO_STREAM("map_merge: " << r.name << ": " << r.message << pose.str());
 				}
 		});

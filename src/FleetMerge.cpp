@@ -1,6 +1,7 @@
 #include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GridMapFusion.h>
+#include <multires_map_merge/JointPlacement.h>
 
 #include <algorithm>
 #include <atomic>
@@ -248,6 +249,13 @@ FleetResult placeFromPairs(
 	const Tree tree = consistentTree(maps, reference, edges, params.cycle_tolerance_cells);
 	out.edges = std::move(edges);
 	out.maps = tree.maps;
+	if (params.joint_refinement)
+	{
+		const auto joint = refineJointly(maps, reference, out.maps, out.edges, params.cycle_tolerance_cells);
+		for (size_t m = 0; m < maps.size(); ++m)
+			if (joint[m])
+				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
+	}
 	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		if (out.maps[m].placed) continue;

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 
@@ -118,6 +119,11 @@ TEST(Fleet, PlacesEveryRobotOfTheBuildingAndKeepsTheOtherBuildingOut)
 	// placed through another robot, not directly.
 	EXPECT_GT(r.maps[3].parent, 0) << r.maps[3].message;
 	EXPECT_EQ(r.pairs_aligned + r.pairs_skipped, f.maps.size() * (f.maps.size() - 1) / 2);
+	// Placed through a chain, it lands as close as the robots placed directly
+	// (every confident pair that sees it places it, not one path).
+	double worst_direct = 0;
+	for (size_t m : {1, 2}) worst_direct = std::max(worst_direct, errorCoarseCells(f, m, r.maps[m].in_reference));
+	EXPECT_LE(errorCoarseCells(f, 3, r.maps[3].in_reference), std::max(0.5, 1.5 * worst_direct)) << r.maps[3].message;
 }
 
 TEST(Fleet, FusesThePlacedMapsOnTheReferenceLattice)
@@ -261,7 +267,9 @@ TEST(FleetGraph, TheMostConfidentPathWinsAndAnUnconnectedMapIsNamed)
 	refused.from = 3, refused.to = 0, refused.message = "alignment not confident enough (confidence 0.2 < 0.5)";
 	refused.confidence = 0;
 	edges.push_back(refused);
-	const FleetResult r = placeFromPairs(blankMaps(4), 0, edges);
+	FleetParams tree_alone;
+	tree_alone.joint_refinement = false;
+	const FleetResult r = placeFromPairs(blankMaps(4), 0, edges, tree_alone);
 	ASSERT_TRUE(r.maps[2].placed);
 	EXPECT_EQ(r.maps[2].parent, 1);  // 0.9 through map 1 beats 0.7 directly
 	expectNear(r.maps[2].in_reference, truth[2]);
@@ -270,4 +278,41 @@ TEST(FleetGraph, TheMostConfidentPathWinsAndAnUnconnectedMapIsNamed)
 	EXPECT_NE(r.maps[3].message.find("not confident enough"), std::string::npos) << r.maps[3].message;
 	EXPECT_FALSE(r.allPlaced());
 	EXPECT_THROW(placeFromPairs(blankMaps(2), 0, {edge(5, 0, {}, 1)}), std::invalid_argument);
+}
+
+TEST(FleetGraph, JointRefinementPlacesAChainedMapByEveryPairThatSeesIt)
+{
+	// Four maps at 10 cm; each link of the chain 0 <- 1 <- 2 <- 3 is the most
+	// confident pair but 1 cell (0.1 m) off, the same way: through the tree,
+	// map k lands k cells off. Two less confident pairs (0 <- 2, 1 <- 3) are
+	// exact and within the cycle tolerance of the chain, so they are kept.
+	const std::vector<Similarity2D> truth = {
+		{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1.25, -0.5, {-3, 4}), Similarity2D(0.8, 2.0, {5, -2})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	auto off = [&](size_t from, size_t to) {
+		Similarity2D t = between(from, to);
+		t.t += truth[to].inverse().linear() * Eigen::Vector2d(0.1, 0);  // 0.1 m along x of map 0
+		return t;
+	};
+	const std::vector<FleetEdge> edges = {
+		edge(1, 0, off(1, 0), 0.99), edge(2, 1, off(2, 1), 0.99), edge(3, 2, off(3, 2), 0.99),
+		edge(2, 0, between(2, 0), 0.8), edge(3, 1, between(3, 1), 0.8)};
+	const std::vector<GridInFrame> maps = blankMaps(4);
+	FleetParams tree_alone;
+	tree_alone.joint_refinement = false;
+	const FleetResult tree = placeFromPairs(maps, 0, edges, tree_alone), joint = placeFromPairs(maps, 0, edges);
+	auto cellsOff = [&](const FleetResult& r, size_t m) { return cornerRms(maps[m], r.maps[m].in_reference, truth[m]) / 0.1; };
+	for (const auto* r : {&tree, &joint})
+		for (size_t m = 0; m < 4; ++m) ASSERT_TRUE(r->maps[m].placed) << m << ": " << r->maps[m].message;
+	EXPECT_FALSE(std::any_of(joint.edges.begin(), joint.edges.end(), [](const FleetEdge& e) { return e.dropped; }));
+	EXPECT_NEAR(cellsOff(tree, 3), 3.0, 0.01);  // the chain's errors add up
+	EXPECT_NEAR(cellsOff(tree, 2), 2.0, 0.01);
+	// Jointly, the chain's end is off by at most a third of what the tree
+	// gives (least squares over these five pairs: 1 cell), and no map by more.
+	for (size_t m = 1; m < 4; ++m) EXPECT_LT(cellsOff(joint, m), 1.2) << m;
+	EXPECT_LT(cellsOff(joint, 3), 0.4 * cellsOff(tree, 3));
+	EXPECT_NE(joint.maps[3].message.find("refined jointly"), std::string::npos) << joint.maps[3].message;
+	// Its parent and confidence are still the tree's: the path that placed it first.
+	EXPECT_EQ(joint.maps[3].parent, 2);
+	EXPECT_DOUBLE_EQ(joint.maps[3].confidence, 0.99);
 }

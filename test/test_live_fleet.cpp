@@ -104,6 +104,7 @@ TEST(LiveFleet, GrowingMapsLateJoinerOtherBuildingAndNoFlicker)
 		ASSERT_TRUE(s.placed) << R[i].name << ": " << s.message;
 		EXPECT_LE(errorCells(full[i], R[i], s.in_world), 2.0) << R[i].name;
 		EXPECT_NEAR(s.in_world.scale, 1.0, 0.01);
+		EXPECT_FALSE(s.stated_resolution_off) << R[i].name << " scale " << s.in_world.scale;  // stated exactly
 	}
 	EXPECT_FALSE(statusOf(fleet, "/robot4").placed);
 	const auto merged = fleet.merged("world");
@@ -214,6 +215,24 @@ TEST(LiveFleet, AFirstRobotThatOverlapsNoOneDoesNotHoldTheWorld)
 	// Committed now: the world stays, whatever comes.
 	fleet.estimate();
 	EXPECT_EQ(fleet.worldRobot(), "/robot1");
+}
+
+TEST(LiveFleet, AStatedResolutionThatIsOffIsSaid)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	ros1::LiveFleet fleet({});
+	const auto& R = robots();
+	for (size_t i : {0, 1}) fleet.addRobot(R[i].name);
+	ASSERT_EQ(fleet.onMap(R[0].name, mapMsg(R[0], 0.5, 1)), "");
+	nav_msgs::OccupancyGrid misstated = mapMsg(R[1], 0.5, 1);
+	misstated.info.resolution = 0.05f;  // 3 cm cells said to be 5 cm
+	ASSERT_EQ(fleet.onMap(R[1].name, misstated), "");
+	fleet.estimate();
+	const auto s2 = statusOf(fleet, "/robot2");
+	ASSERT_TRUE(s2.placed) << s2.message;
+	EXPECT_NEAR(s2.in_world.scale, 0.6, 0.01);
+	EXPECT_TRUE(s2.stated_resolution_off);
+	EXPECT_FALSE(statusOf(fleet, "/robot1").stated_resolution_off);
 }
 
 TEST(LiveFleet, AnEstimationAlignsOnlyWhatChanged)

@@ -3,8 +3,9 @@
 // confident similarities; every map is placed through its most confident
 // path from the reference (maximum spanning tree, a path as sure as its
 // weakest edge); an aligned pair that contradicts the tree around a cycle
-// drops the weakest edge of that cycle; the placed maps are fused with the
-// two-map cell rule. A map that nothing confident connects is reported by
+// drops the weakest edge of that cycle; then every placement is refined at
+// once from all confident pairs kept (JointPlacement.h); the placed maps are
+// fused with the two-map cell rule. A map that nothing confident connects is reported by
 // name as not placed: never dropped silently, never placed on a guess.
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GridInFrame.h>
@@ -54,6 +55,10 @@ struct FleetParams
 	/** A cycle whose composed transform moves a map's corners by more than
 	 * this many cells of the coarser map (RMS) is contradictory. */
 	double cycle_tolerance_cells = 3.0;
+	/** The tree's placements refined at once from every confident pair kept
+	 * (JointPlacement.h): a map reached through a chain is then placed by
+	 * every pair that sees it, not by one path. */
+	bool joint_refinement = true;
 };
 
 /** What a caller that places the same fleet again and again (LiveFleet, as

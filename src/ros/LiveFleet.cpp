@@ -394,6 +394,19 @@ std::optional<nav_msgs::OccupancyGrid> LiveFleet::merged(const std::string& worl
 	return result;
 }
 
+double LiveFleet::scalePrecision(const Robot& r) const
+{
+	// A placement is good to about a coarse cell at each end of the map: its
+	// scale to about two coarse cells over the map's extent.
+	const auto& info = r.map->info;
+	const double extent = info.resolution * std::hypot(double(info.width), double(info.height));
+	double world_cell = info.resolution;
+	for (const auto& w : robots_)
+		if (w.name == world_robot_ && w.map) world_cell = w.map->info.resolution;
+	const double coarse = std::max<double>(info.resolution, world_cell / r.in_world.scale);
+	return extent > 0 ? 2 * coarse / extent : 0.0;
+}
+
 std::vector<LiveFleet::RobotStatus> LiveFleet::status() const
 {
 	std::lock_guard<std::mutex> lock(mutex_);
@@ -408,6 +421,7 @@ std::vector<LiveFleet::RobotStatus> LiveFleet::status() const
 		s.in_world = r.in_world;
 		s.confidence = r.confidence;
 		s.message = r.message;
+		s.stated_resolution_off = r.placed && r.map && std::abs(std::log(r.in_world.scale)) > scalePrecision(r);
 		out.push_back(s);
 	}
 	return out;

@@ -95,6 +95,9 @@ class LiveFleet
 		Similarity2D in_world;  //!< its map frame → the world (scale when metadata lies)
 		double confidence = 0;
 		std::string message;
+		/** The scale departs from 1 by more than the placement can tell (two
+		 * coarse cells over the map's extent): its stated resolution is off. */
+		bool stated_resolution_off = false;
 	};
 	/** Every robot, in the order they were added. */
 	std::vector<RobotStatus> status() const;
@@ -149,6 +152,8 @@ class LiveFleet
 	bool agree(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b) const;
 	/** A robot besides the world's is placed: the world may no longer move. */
 	bool worldCommitted() const;
+	/** How far its placement's log scale can be trusted (lock held). */
+	double scalePrecision(const Robot& r) const;
 
 	LiveFleetParams params_;
 	mutable std::mutex mutex_;

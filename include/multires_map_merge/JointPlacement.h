@@ -1,0 +1,37 @@
+#pragma once
+// A fleet's placements refined at once (FleetMerge's last step). The spanning
+// tree places each map through one path of pairs, so a map reached through a
+// chain carries every link's error. Every confident pair kept is a
+// measurement of the similarity between two maps; the placements that agree
+// best with all of them at once are found by linear least squares, because a
+// 2-D similarity is a complex affine map z ↦ a·z + b (a = s·e^{iθ}), and
+// "pair (f → t) says T_f = T_t ∘ M" is linear in (a, b) of both maps.
+#include <multires_map_merge/FleetMerge.h>
+
+#include <optional>
+#include <vector>
+
+namespace multires_map_merge
+{
+struct JointPlacementParams
+{
+	/** Iteratively reweighted least squares: a pair that disagrees with the
+	 * joint placement by more than this many cells of its coarser map (RMS
+	 * over the corners of the `from` map's content) counts less (Huber), so
+	 * one bad pair cannot pull the others. */
+	double robust_cells = 1.0;
+	int reweighting_rounds = 5;
+};
+
+/** Every placed map's pose in the reference's frame (`in_reference` of each
+ * placed map; the reference fixed) refined from every confident pair that is
+ * not dropped and joins two placed maps. A map whose refined pose moves its
+ * content by more than `max_move_cells` from its tree placement keeps the
+ * tree's (the cycle check admits pairs within that much of each other: a
+ * larger move means the pairs do not support one placement). Returns, per
+ * map, the refined pose, or nothing where the tree's stays. */
+std::vector<std::optional<Similarity2D>> refineJointly(
+	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
+	const std::vector<FleetEdge>& edges, double max_move_cells, const JointPlacementParams& params = {});
+
+}  // namespace multires_map_merge

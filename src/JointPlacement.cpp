@@ -1,0 +1,135 @@
+#include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/JointPlacement.h>
+
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace multires_map_merge
+{
+namespace
+{
+using Corners = std::array<Eigen::Vector2d, 4>;
+
+/** The corners of the box around what a map saw (its known cells), in its
+ * frame: where its placement matters; the grid's padding does not. */
+Corners contentCorners(const GridInFrame& map)
+{
+	std::vector<cv::Point> known;
+	cv::findNonZero(toClassImage(map.grid) != kUnknown, known);
+	cv::Rect box(0, 0, int(map.grid.getSizeX()), int(map.grid.getSizeY()));
+	if (!known.empty()) box = cv::boundingRect(known);
+	const Similarity2D cells = map.cellToMapFrame();
+	const double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
+	return {cells({x0, y0}), cells({x1, y0}), cells({x0, y1}), cells({x1, y1})};
+}
+
+/** The 2×2 block of z ↦ a·z as a function of a = (re, im): a·z is linear in a. */
+Eigen::Matrix2d timesPoint(const Eigen::Vector2d& z)
+{
+	Eigen::Matrix2d m;
+	m << z.x(), -z.y(), z.y(), z.x();
+	return m;
+}
+
+/** The reference's cells of the coarser map of the pair, in reference metres:
+ * residuals are weighed in the cells the pair was aligned at. */
+double coarseCellInReference(
+	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
+{
+	const double coarse = std::max<double>(
+		maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
+	return coarse * placements[e.to].in_reference.scale;
+}
+
+double cornersRms(const Corners& corners, const Similarity2D& a, const Similarity2D& b)
+{
+	double se = 0;
+	for (const auto& c : corners) se += (a(c) - b(c)).squaredNorm();
+	return std::sqrt(se / corners.size());
+}
+}  // namespace
+
+std::vector<std::optional<Similarity2D>> refineJointly(
+	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
+	const std::vector<FleetEdge>& edges, double max_move_cells, const JointPlacementParams& params)
+{
+	const size_t n = maps.size();
+	std::vector<std::optional<Similarity2D>> out(n);
+	// The unknowns: (Re a, Im a, Re b, Im b) of each placed map but the reference.
+	std::vector<int> column(n, -1);
+	int unknowns = 0;
+	for (size_t m = 0; m < n; ++m)
+		if (m != reference && placements[m].placed) column[m] = 4 * unknowns++;
+	std::vector<size_t> used;
+	for (size_t k = 0; k < edges.size(); ++k)
+	{
+		const FleetEdge& e = edges[k];
+		if (e.merged && !e.dropped && placements[e.from].placed && placements[e.to].placed) used.push_back(k);
+	}
+	if (unknowns == 0 || used.size() <= size_t(unknowns)) return out;  // a tree: nothing to balance
+
+	std::vector<Corners> corners(n);
+	for (size_t m = 0; m < n; ++m)
+		if (placements[m].placed) corners[m] = contentCorners(maps[m]);
+	const int rows = int(used.size()) * 8, cols = 4 * unknowns;
+	std::vector<double> weight(used.size(), 1.0);
+	Eigen::VectorXd x;
+	for (int round = 0; round <= params.reweighting_rounds; ++round)
+	{
+		Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, cols);
+		Eigen::VectorXd y = Eigen::VectorXd::Zero(rows);
+		for (size_t i = 0; i < used.size(); ++i)
+		{
+			const FleetEdge& e = edges[used[i]];
+			const double w = std::sqrt(weight[i]) / coarseCellInReference(maps, placements, e);
+			for (int c = 0; c < 4; ++c)
+			{
+				// T_from(p) − T_to(M(p)) = 0 for the corners p of the from map.
+				const Eigen::Vector2d p = corners[e.from][c], q = e.from_to_to(p);
+				const int r = int(i) * 8 + 2 * c;
+				if (column[e.from] >= 0)
+				{
+					a.block<2, 2>(r, column[e.from]) += w * timesPoint(p);
+					a.block<2, 2>(r, column[e.from] + 2) += w * Eigen::Matrix2d::Identity();
+				}
+				else
+					y.segment<2>(r) -= w * p;
+				if (column[e.to] >= 0)
+				{
+					a.block<2, 2>(r, column[e.to]) -= w * timesPoint(q);
+					a.block<2, 2>(r, column[e.to] + 2) -= w * Eigen::Matrix2d::Identity();
+				}
+				else
+					y.segment<2>(r) += w * q;
+			}
+		}
+		x = a.colPivHouseholderQr().solve(y);
+		if (!x.allFinite()) return out;
+		// Huber: a pair's weight falls as its disagreement passes robust_cells.
+		for (size_t i = 0; i < used.size(); ++i)
+		{
+			// The rows hold sqrt(weight) / cell × each corner's two coordinates.
+			const double r = (a.middleRows(int(i) * 8, 8) * x - y.segment<8>(int(i) * 8)).norm() /
+				(2 * std::sqrt(weight[i]));
+			weight[i] = r <= params.robust_cells ? 1.0 : params.robust_cells / r;
+		}
+	}
+	for (size_t m = 0; m < n; ++m)
+	{
+		if (column[m] < 0) continue;
+		const Eigen::Vector2d lin = x.segment<2>(column[m]), shift = x.segment<2>(column[m] + 2);
+		const Similarity2D joint(lin.norm(), std::atan2(lin.y(), lin.x()), shift);
+		if (!joint.isFinite() || !(joint.scale > 0)) continue;
+		const Similarity2D& tree = placements[m].in_reference;
+		const double cell = std::max<double>(
+			maps[reference].grid.getResolution(), maps[m].grid.getResolution() * tree.scale);
+		if (cornersRms(corners[m], joint, tree) / cell <= max_move_cells) out[m] = joint;
+	}
+	return out;
+}
+
+}  // namespace multires_map_merge
