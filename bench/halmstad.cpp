@@ -162,6 +162,14 @@ Similarity2D fineToCoarse(double factor, int fine_rows, int coarse_rows)
 	return Similarity2D(1 / factor, 0, {0, (coarse_rows - fine_rows / factor) * r});
 }
 
+double median(std::vector<double> v)
+{
+	v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
+	if (v.empty()) return NAN;
+	std::sort(v.begin(), v.end());
+	return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
 Similarity2D truthBetweenMapFrames(const HalmstadPair& p, int src_rows, int dst_rows)
 {
 	// Two points fix a similarity; the pixel↔metre maps flip y, which turns

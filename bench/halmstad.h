@@ -98,6 +98,9 @@ std::string coarserYaml(const HalmstadData& data, const std::string& map, double
  * origin 0): what turns a transform of the coarse map into the fine one's. */
 Similarity2D fineToCoarse(double factor, int fine_rows, int coarse_rows);
 
+/** The median of the finite values (NaN if none). */
+double median(std::vector<double> v);
+
 /** Judges a transform between the maps' frames (x_ref = est(x_other); REF =
  * dst, OTHER = src, both loaded from the yamls) against the annotation:
  * mean displacement ≤ 40 px and correspondence RMS ≤ max(2·rms_px, 40 px). */

@@ -66,7 +66,7 @@ HalmstadFleetRun runFleet(
 		const std::string yaml =
 			factor[i] == 1.0 ? data.yaml(names[i], dir) : coarserYaml(data, names[i], factor[i], dir);
 		fine.push_back(loadGridMap(data.yaml(names[i], dir)));
-		rows.push_back(int(loadGridMap(yaml).grid.getSizeY()));
+		rows.push_back(int(factor[i] == 1.0 ? fine.back().grid.getSizeY() : loadGridMap(yaml).grid.getSizeY()));
 		// The yaml's image is absolute or beside it in `dir`: copied there too.
 		std::ifstream in(yaml);
 		std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -105,13 +105,6 @@ HalmstadFleetRun runFleet(
 	}
 	fs::remove_all(fleet_dir);
 	return run;
-}
-
-double median(std::vector<double> v)
-{
-	if (v.empty()) return NAN;
-	std::sort(v.begin(), v.end());
-	return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 double largest(const std::vector<double>& v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); }

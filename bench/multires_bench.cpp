@@ -317,13 +317,6 @@ PairResult runPair(const std::string& set, const std::string& log, double rr, do
 }
 
 // ---------------------------------------------------------------- statistics
-double median(std::vector<double> v)
-{
-	v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return !std::isfinite(x); }), v.end());
-	if (v.empty()) return NAN;
-	std::sort(v.begin(), v.end());
-	return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 template <class F>
 std::vector<double> column(const std::vector<PairResult>& rs, F f)
