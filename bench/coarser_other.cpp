@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 std::vector<CoarserRun> runCoarserOther(
 	const HalmstadData& data, const std::vector<std::string>& sites, const std::vector<double>& factors,
-	const CScalingGridMapAligner::TConfigParams& options, const std::string& dir)
+	const CScalingGridMapAligner::TConfigParams& options, const std::string& dir, const CoarserCandidatesSink& sink)
 {
 	CScalingGridMapAligner aligner;
 	aligner.options = options;
@@ -39,12 +39,16 @@ std::vector<CoarserRun> runCoarserOther(
 				const auto r = aligner.alignScaled(ref, coarse);
 				run.seconds = clock.Tac();
 				run.merged = r.success;
-				if (r.candidates.size())
-				{
-					const Similarity2D fine_in_ref = r.metric.compose(fineToCoarse(
-						factor, int(fine.grid.getSizeY()), int(coarse.grid.getSizeY())));
-					run.outcome = judge(fine_in_ref, p, fine, int(ref.grid.getSizeY()));
-				}
+				const Similarity2D fine_in_coarse =
+					fineToCoarse(factor, int(fine.grid.getSizeY()), int(coarse.grid.getSizeY()));
+				const int ref_rows = int(ref.grid.getSizeY());
+				if (r.candidates.size()) run.outcome = judge(r.metric.compose(fine_in_coarse), p, fine, ref_rows);
+				if (sink)
+					sink(run, ref, coarse, r, [&](const Similarity2D& cells) {
+						const HalmstadOutcome o =
+							judge(candidateMetric(ref, cells, coarse).compose(fine_in_coarse), p, fine, ref_rows);
+						return std::pair<double, bool>{o.mean_displacement_px, o.right};
+					});
 				std::cout << "coarser x" << factor << " " << run.ref << " <- " << run.other << ": "
 						  << (run.merged ? (run.outcome.right ? "merged right" : "MERGED WRONG") : "refused") << " disp "
 						  << run.outcome.mean_displacement_px << " px, scale " << r.cells.scale << ", " << run.seconds

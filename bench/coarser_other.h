@@ -9,7 +9,9 @@
 
 #include <multires_map_merge/CScalingGridMapAligner.h>
 
+#include <functional>
 #include <ostream>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -24,10 +26,20 @@ struct CoarserRun
 	double seconds = 0;
 };
 
+/** A candidate's displacement against the annotation [px] and whether that is right. */
+using CandidateError = std::function<std::pair<double, bool>(const multires_map_merge::Similarity2D& cells)>;
+/** Called after each pair with its maps, its result and how to judge any of
+ * its candidates (cells of REF ← cells of the coarse OTHER): the calibration
+ * data's writer. */
+using CoarserCandidatesSink = std::function<void(const CoarserRun&, const GridInFrame& ref,
+	const GridInFrame& coarse_other, const multires_map_merge::CScalingGridMapAligner::TReturnInfo&,
+	const CandidateError&)>;
+
 /** Every unordered same-site pair of `sites` at each of `factors`. */
 std::vector<CoarserRun> runCoarserOther(
 	const HalmstadData& data, const std::vector<std::string>& sites, const std::vector<double>& factors,
-	const multires_map_merge::CScalingGridMapAligner::TConfigParams& options, const std::string& dir);
+	const multires_map_merge::CScalingGridMapAligner::TConfigParams& options, const std::string& dir,
+	const CoarserCandidatesSink& sink = {});
 
 /** Merged right and merged wrong over the runs of `factor` on sites of one role. */
 struct CoarserTotals

@@ -185,6 +185,11 @@ Similarity2D truthBetweenMapFrames(const HalmstadPair& p, int src_rows, int dst_
 	return t;
 }
 
+Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, const GridInFrame& other)
+{
+	return betweenMapFrames(ref, cellToMetric(ref.grid).compose(cells).compose(cellToMetric(other.grid).inverse()), other);
+}
+
 HalmstadOutcome judge(const Similarity2D& est, const HalmstadPair& p, const GridInFrame& other, int ref_rows)
 {
 	HalmstadOutcome o;

@@ -101,6 +101,9 @@ Similarity2D fineToCoarse(double factor, int fine_rows, int coarse_rows);
 /** The median of the finite values (NaN if none). */
 double median(std::vector<double> v);
 
+/** A candidate's transform of cells (REF ← OTHER) between the maps' frames. */
+Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, const GridInFrame& other);
+
 /** Judges a transform between the maps' frames (x_ref = est(x_other); REF =
  * dst, OTHER = src, both loaded from the yamls) against the annotation:
  * mean displacement ≤ 40 px and correspondence RMS ≤ max(2·rms_px, 40 px). */

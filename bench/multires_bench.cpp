@@ -194,12 +194,6 @@ void writeCandidates(
 /** For negatives: no candidate can be right. */
 std::pair<double, bool> noTruth(const Similarity2D&) { return {NAN, false}; }
 
-/** A candidate's cell transform between the maps' frames. */
-Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, const GridInFrame& other)
-{
-	return betweenMapFrames(ref, cellToMetric(ref.grid).compose(cells).compose(cellToMetric(other.grid).inverse()), other);
-}
-
 // ---------------------------------------------------------------- one pair
 struct PairResult
 {
@@ -585,7 +579,7 @@ int fleetChild(const std::string& dir)
 		{
 			const auto& p = result->maps[i].in_reference;
 			std::cout << tag << " " << i << " " << result->maps[i].placed << " " << p.scale << " " << p.yaw << " "
-					  << p.t.x() << " " << p.t.y() << std::endl;
+					  << p.t.x() << " " << p.t.y() << " " << result->maps[i].parent << std::endl;
 		}
 	return 0;
 }
@@ -989,6 +983,27 @@ HalmstadRun runHalmstadPair(
 	return run;
 }
 
+/** Calibration pairs of the kind the package exists for: each E5 and HIH
+ * pair (REF = the later map) with OTHER recorded as a coarser grid whose
+ * stated resolution is wrong (the coarser-OTHER section's maps). Each
+ * candidate judged as it would be reported, as runHalmstadPair does. */
+void runCoarserCalibrationPairs(const HalmstadData& data)
+{
+	const std::string dir = (fs::temp_directory_path() / ("multires_bench_coarser_" + std::to_string(getpid()))).string();
+	const auto sink = [](const CoarserRun& run, const GridInFrame& ref, const GridInFrame& other,
+						  const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of) {
+		const auto ref_prepared = benchAligner().prepare(ref.grid), other_prepared = benchAligner().prepare(other.grid);
+		const auto& o = g_aligner_options;
+		std::ostringstream other_name;
+		other_name << run.other << "_x" << run.factor;
+		writeCandidates(run.site, run.ref, other_name.str(), true, true, r, error_of, [&](const auto& c) {
+			return finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells, o.finishParams(), o.decision);
+		});
+	};
+	runCoarserOther(data, {"E5", "HIH"}, kCoarserFactors, g_aligner_options, dir, sink);
+	fs::remove_all(dir);
+}
+
 /** The issue's pair sets: every unordered same-site pair (REF = the later
  * map), and cross-site negatives: each map of one site against maps of the
  * others, `negatives_per_map` each. */
@@ -1111,6 +1126,8 @@ int main(int argc, char** argv)
 		"aligner parameters, section [aligner] of an MRPT ini file (calibration data made with other defaults)",
 		false, "", "FILE.ini", cmd);
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
+	TCLAP::SwitchArg coarser_pairs_arg(
+		"", "coarser-pairs-only", "with --calibration-data: only the E5 and HIH pairs with OTHER recorded coarser", cmd);
 	TCLAP::SwitchArg live_pairs_arg(
 		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
 	TCLAP::ValueArg<std::string> coarser_arg(
@@ -1181,15 +1198,18 @@ int main(int argc, char** argv)
 			// screen's included), of every pair, not on those a decision kept.
 			g_aligner_options.exhaustive_search = true;
 			const HalmstadData data(g_data + "/halmstad");
-			if (!extra_arg.getValue() && !live_pairs_arg.getValue())
+			const bool everything =
+				!extra_arg.getValue() && !live_pairs_arg.getValue() && !coarser_pairs_arg.getValue();
+			if (everything)
 			{
 				runHalmstad(data, {"E5", "HIH"}, negatives_arg.getValue());
 				runReverseCalibrationPositives(data);
 				runReverseCrossSiteNegatives(data, negatives_arg.getValue());
 				runCarmenNegatives(false);
 			}
-			if (!live_pairs_arg.getValue()) runExtraCalibrationNegatives(data);
-			if (!extra_arg.getValue()) runLiveFleetCalibrationPairs();
+			if (everything || extra_arg.getValue()) runExtraCalibrationNegatives(data);
+			if (everything || live_pairs_arg.getValue()) runLiveFleetCalibrationPairs();
+			if (everything || coarser_pairs_arg.getValue()) runCoarserCalibrationPairs(data);
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
 		}
