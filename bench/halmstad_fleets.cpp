@@ -1,5 +1,6 @@
 #include "halmstad_fleets.h"
 
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/MapIO.h>
 
 #include <algorithm>
@@ -20,22 +21,23 @@ namespace
 {
 constexpr double kMixedFactors[] = {1.0, 2.0, 1.4};  // map i recorded ×kMixedFactors[i % 3]
 
-/** A placement line of the child: "MAP i placed scale yaw x y". */
+/** A placement line of the child: "MAP i placed scale yaw x y parent". */
 struct Placed
 {
 	bool placed = false;
 	Similarity2D in_reference;
+	int parent = -1;  //!< the map it was placed through
 };
 
 /** Scores map i's placement in the reference's frame against the annotation
  * (its fine map, as the coarser runs are judged). */
-void score(FleetPlacing& tally, const Placed& p, const HalmstadData& data, const std::string& name,
+double score(FleetPlacing& tally, const Placed& p, const HalmstadData& data, const std::string& name,
 		   const std::string& ref_name, double factor, const GridInFrame& fine, int coarse_rows, int ref_rows)
 {
 	if (!p.placed)
 	{
 		++tally.not_placed;
-		return;
+		return NAN;
 	}
 	const HalmstadPair* truth = data.pair(name, ref_name);
 	if (!truth) throw std::runtime_error("no annotation for " + name + " -> " + ref_name);
@@ -45,6 +47,7 @@ void score(FleetPlacing& tally, const Placed& p, const HalmstadData& data, const
 	const HalmstadOutcome o = judge(fine_in_ref, *truth, fine, ref_rows);
 	(o.right ? tally.right : tally.wrong)++;
 	tally.displacement_px.push_back(o.mean_displacement_px);
+	return o.mean_displacement_px;
 }
 
 HalmstadFleetRun runFleet(
@@ -93,15 +96,20 @@ HalmstadFleetRun runFleet(
 		{
 			size_t i = 0;
 			Placed p;
-			in >> i >> p.placed >> p.in_reference.scale >> p.in_reference.yaw >> p.in_reference.t.x() >> p.in_reference.t.y();
+			in >> i >> p.placed >> p.in_reference.scale >> p.in_reference.yaw >> p.in_reference.t.x() >> p.in_reference.t.y() >>
+				p.parent;
 			placed[tag][i] = p;
 		}
 	}
 	if (!(run.seconds > 0)) throw std::runtime_error("Halmstad fleet " + site + " failed (see " + out + ")");
 	for (size_t i = 1; i < names.size(); ++i)
 	{
-		score(run.joint, placed["MAP"][i], data, names[i], names[0], factor[i], fine[i], rows[i], rows[0]);
-		score(run.tree, placed["TREE"][i], data, names[i], names[0], factor[i], fine[i], rows[i], rows[0]);
+		const double joint =
+			score(run.joint, placed["MAP"][i], data, names[i], names[0], factor[i], fine[i], rows[i], rows[0]);
+		const double tree =
+			score(run.tree, placed["TREE"][i], data, names[i], names[0], factor[i], fine[i], rows[i], rows[0]);
+		std::cout << "  " << names[i] << ": " << joint << " px (tree alone " << tree << ") through map "
+				  << placed["MAP"][i].parent << std::endl;
 	}
 	fs::remove_all(fleet_dir);
 	return run;
@@ -155,7 +163,9 @@ void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleet
 		  "occupied pixels, px of 5 cm). *Mixed cells*: the maps recorded ×1, ×2, ×1.4 in turn, all stated "
 		  "0.05 m. *Tree alone*: the same pairs, each map placed through its one most confident path (joint "
 		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree by more than "
-		  "`cycle_tolerance_cells` (3) at the map's corners; the joint refinement uses only the pairs kept.\n\n"
+		  "`cycle_tolerance_cells` (" << multires_map_merge::FleetParams{}.cycle_tolerance_cells << ") at the corners of what the map saw; "
+		  "the joint refinement uses only the pairs kept. Each map's displacement and the map it was placed through "
+		  "are printed as the section runs.\n\n"
 	   << "| site | cells | right | wrong | not placed | displacement median [px] | max [px] | tree alone: right | "
 		  "wrong | not placed | median [px] | max [px] | pairs aligned | confident | of which dropped by a cycle | pairs skipped | "
 		  "time [s] | peak RSS [MB] |\n"

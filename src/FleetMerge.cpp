@@ -1,11 +1,15 @@
 #include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/FeatureHypotheses.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GridMapFusion.h>
 #include <multires_map_merge/JointPlacement.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -32,6 +36,24 @@ double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity
 	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
 		se += (a(cells(c)) - b(cells(c))).squaredNorm();
 	return std::sqrt(se / 4);
+}
+
+ContentCorners contentCorners(const GridInFrame& map)
+{
+	std::vector<cv::Point> known;
+	cv::findNonZero(toClassImage(map.grid) != kUnknown, known);
+	cv::Rect box(0, 0, int(map.grid.getSizeX()), int(map.grid.getSizeY()));
+	if (!known.empty()) box = cv::boundingRect(known);
+	const Similarity2D cells = map.cellToMapFrame();
+	const double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
+	return {cells({x0, y0}), cells({x1, y0}), cells({x0, y1}), cells({x1, y1})};
+}
+
+double cornersRms(const ContentCorners& corners, const Similarity2D& a, const Similarity2D& b)
+{
+	double se = 0;
+	for (const auto& c : corners) se += (a(c) - b(c)).squaredNorm();
+	return std::sqrt(se / corners.size());
 }
 
 namespace
@@ -146,11 +168,14 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 	return out;
 }
 
-/** cornerRms in cells of the coarser map of the pair. */
-double disagreementCells(const GridInFrame& from, const GridInFrame& to, const Similarity2D& a, const Similarity2D& b)
+/** How far apart two placements of `from` in `to` put what `from` saw, in
+ * cells of the coarser map of the pair. */
+double disagreementCells(
+	const GridInFrame& from, const ContentCorners& from_corners, const GridInFrame& to, const Similarity2D& a,
+	const Similarity2D& b)
 {
 	const double coarse = std::max<double>(to.grid.getResolution(), from.grid.getResolution() * a.scale);
-	return cornerRms(from, a, b) / coarse;
+	return cornersRms(from_corners, a, b) / coarse;
 }
 
 struct Tree
@@ -161,8 +186,11 @@ struct Tree
 
 /** Maximum spanning tree from the reference over the confident, kept edges
  * (Prim): each map joins through the most confident edge to the placed
- * part, so its path is the most confident one (as sure as its weakest edge). */
-Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edges)
+ * part, so its path is the most confident one (as sure as its weakest edge).
+ * Confidences of `sure` and above count as one: among sure paths the one of
+ * fewest pairs wins, since each pair adds its own error (bent maps: a few
+ * cells each) and a surer-by-a-hair chain only adds more. */
+Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edges, double sure)
 {
 	Tree t;
 	t.maps.assign(n, {});
@@ -170,6 +198,14 @@ Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edge
 	t.maps[reference].placed = true;
 	t.maps[reference].confidence = 1;
 	t.maps[reference].message = "reference";
+	std::vector<size_t> hops(n, 0);
+	auto anchorOf = [&](const FleetEdge& e) { return t.maps[e.from].placed ? e.from : e.to; };
+	auto better = [&](const FleetEdge& a, const FleetEdge& b) {
+		const double ca = std::min(a.confidence, sure), cb = std::min(b.confidence, sure);
+		if (ca != cb) return ca > cb;
+		if (hops[anchorOf(a)] != hops[anchorOf(b)]) return hops[anchorOf(a)] < hops[anchorOf(b)];
+		return a.confidence > b.confidence;
+	};
 	for (;;)
 	{
 		int best = -1;
@@ -177,12 +213,13 @@ Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edge
 		{
 			const FleetEdge& e = edges[k];
 			if (!e.merged || e.dropped || t.maps[e.from].placed == t.maps[e.to].placed) continue;
-			if (best < 0 || e.confidence > edges[best].confidence) best = static_cast<int>(k);
+			if (best < 0 || better(e, edges[best])) best = static_cast<int>(k);
 		}
 		if (best < 0) break;
 		const FleetEdge& e = edges[best];
 		const bool from_new = !t.maps[e.from].placed;
 		const size_t added = from_new ? e.from : e.to, anchor = from_new ? e.to : e.from;
+		hops[added] = hops[anchor] + 1;
 		FleetPlacement& p = t.maps[added];
 		p.placed = true;
 		p.in_reference = from_new ? t.maps[anchor].in_reference.compose(e.from_to_to)
@@ -207,11 +244,14 @@ std::vector<int> pathEdges(const Tree& t, size_t a)
 
 /** Builds the tree; while a kept non-tree edge contradicts it, drops the
  * weakest edge of that cycle and rebuilds. */
-Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge>& edges, double tol)
+Tree consistentTree(
+	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
+	std::vector<FleetEdge>& edges, const FleetParams& params)
 {
+	const double tol = params.cycle_tolerance_cells;
 	for (;;)
 	{
-		Tree t = spanningTree(maps.size(), reference, edges);
+		Tree t = spanningTree(maps.size(), reference, edges, params.settled_confidence);
 		int contradicted = -1;
 		for (size_t k = 0; k < edges.size() && contradicted < 0; ++k)
 		{
@@ -219,7 +259,8 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 			if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
 			if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
-			if (disagreementCells(maps[e.from], maps[e.to], predicted, e.from_to_to) > tol) contradicted = int(k);
+			if (disagreementCells(maps[e.from], corners[e.from], maps[e.to], predicted, e.from_to_to) > tol)
+				contradicted = int(k);
 		}
 		if (contradicted < 0) return t;
 		// The cycle: this edge and both tree paths up to where they meet (the
@@ -236,22 +277,100 @@ Tree consistentTree(const std::vector<GridInFrame>& maps, size_t reference, std:
 		edges[weakest].dropped = true;
 	}
 }
-}  // namespace
+
+using PairKey = std::pair<size_t, size_t>;  // (lower, higher) map index
+PairKey keyOf(size_t a, size_t b) { return {std::min(a, b), std::max(a, b)}; }
+
+/** How promising a pair looks before it is aligned: the most RANSAC inliers
+ * among its feature hypotheses (the features are prepared: a few ms). An
+ * order only: a map not placed still tries every pair. */
+double promiseOf(const PreparedMap& a, const PreparedMap& b, const FeatureParams& p)
+{
+	if (!a.problem.empty() || !b.problem.empty()) return -1;
+	const auto hypotheses = featureHypotheses(a.features, b.features, p);
+	return hypotheses.empty() ? 0 : hypotheses.front().inliers;
+}
+
+/** What the next round needs to know of the fleet so far. */
+struct FleetProgress
+{
+	const FleetResult& placed;
+	const std::set<PairKey>& tried;
+	/** Pairs aligned for each map since it was placed, looking for another path. */
+	const std::vector<size_t>& tries_since_placed;
+};
+
+/** Whether map m still wants pairs: not placed; or placed by fewer than two
+ * kept confident pairs, or less surely than settled, and not yet given
+ * `second_path_tries` more pairs to find another path. */
+bool wantsPairs(size_t m, size_t reference, const FleetProgress& f, const FleetParams& params)
+{
+	if (m == reference) return false;
+	const FleetPlacement& p = f.placed.maps[m];
+	if (!p.placed) return true;
+	size_t kept = 0;
+	for (const FleetEdge& e : f.placed.edges) kept += (e.from == m || e.to == m) && e.merged && !e.dropped;
+	const bool sure = kept >= 2 && p.confidence >= params.settled_confidence;
+	return !sure && f.tries_since_placed[m] < params.second_path_tries;
+}
+
+/** The next round: each map that wants pairs takes its most promising one
+ * not yet tried, towards a placed map first (one that can carry it); then,
+ * while the round has fewer pairs than threads, each takes its next one. */
+PairList nextPairs(
+	size_t reference, const FleetProgress& f, const std::function<double(size_t, size_t)>& promise,
+	const FleetParams& params, unsigned threads)
+{
+	const size_t n = f.placed.maps.size();
+	std::vector<std::vector<size_t>> partners(n);  // per map wanting pairs, best first
+	for (size_t m = 0; m < n; ++m)
+	{
+		if (!wantsPairs(m, reference, f, params)) continue;
+		for (size_t o = 0; o < n; ++o)
+			if (o != m && !f.tried.count(keyOf(m, o))) partners[m].push_back(o);
+		const auto& maps = f.placed.maps;
+		std::stable_sort(partners[m].begin(), partners[m].end(), [&](size_t a, size_t b) {
+			if (maps[a].placed != maps[b].placed) return maps[a].placed;
+			return promise(m, a) > promise(m, b);
+		});
+	}
+	PairList out;
+	std::set<PairKey> chosen;
+	if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+	for (size_t depth = 0;; ++depth)
+	{
+		bool any = false;
+		for (size_t m = 0; m < n; ++m)
+		{
+			if (depth >= partners[m].size()) continue;
+			any = true;
+			const size_t o = partners[m][depth];
+			if (!chosen.insert(keyOf(m, o)).second) continue;
+			const bool o_first = f.placed.maps[o].placed && !f.placed.maps[m].placed;
+			out.emplace_back(o_first ? o : m, o_first ? m : o);  // (to, from): a placed map is the reference
+		}
+		if (!any || out.size() >= threads) return out;
+	}
+}
+
+std::vector<ContentCorners> contentCornersOf(const std::vector<GridInFrame>& maps)
+{
+	std::vector<ContentCorners> out;
+	for (const auto& m : maps) out.push_back(contentCorners(m));
+	return out;
+}
 
 FleetResult placeFromPairs(
-	const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge> edges, const FleetParams& params)
+	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
+	std::vector<FleetEdge> edges, const FleetParams& params)
 {
-	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
-	for (const auto& e : edges)
-		if (e.from >= maps.size() || e.to >= maps.size() || e.from == e.to)
-			throw std::invalid_argument("a pair names a map that is not there");
 	FleetResult out;
-	const Tree tree = consistentTree(maps, reference, edges, params.cycle_tolerance_cells);
+	const Tree tree = consistentTree(maps, corners, reference, edges, params);
 	out.edges = std::move(edges);
 	out.maps = tree.maps;
 	if (params.joint_refinement)
 	{
-		const auto joint = refineJointly(maps, reference, out.maps, out.edges, params.cycle_tolerance_cells);
+		const auto joint = refineJointly(maps, reference, out.maps, out.edges, corners, params.cycle_tolerance_cells);
 		for (size_t m = 0; m < maps.size(); ++m)
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
@@ -271,6 +390,17 @@ FleetResult placeFromPairs(
 	}
 	return out;
 }
+}  // namespace
+
+FleetResult placeFromPairs(
+	const std::vector<GridInFrame>& maps, size_t reference, std::vector<FleetEdge> edges, const FleetParams& params)
+{
+	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
+	for (const auto& e : edges)
+		if (e.from >= maps.size() || e.to >= maps.size() || e.from == e.to)
+			throw std::invalid_argument("a pair names a map that is not there");
+	return placeFromPairs(maps, contentCornersOf(maps), reference, std::move(edges), params);
+}
 
 FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
@@ -280,25 +410,48 @@ FleetResult placeFleet(
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();
 	std::vector<FleetEdge> edges;
-	std::set<std::pair<size_t, size_t>> done;  // unordered pairs aligned, reused or deferred
-	auto key = [](size_t a, size_t b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+	std::set<PairKey> done;  // unordered pairs aligned, reused or deferred
 
-	// Round 1: everything against the reference (the two-map case exactly).
+	// Round 1: everything against the reference (the two-map case exactly),
+	// and every earlier result that still holds (it costs nothing).
 	PairList todo;
 	for (size_t k = 0; k < n; ++k)
 		if (k != reference) todo.emplace_back(reference, k);
+	if (hints.known)
+		for (size_t a = 0; a < n; ++a)
+			for (size_t b = a + 1; b < n; ++b)
+				if (a != reference && b != reference)
+					if (const auto known = hints.known(a, b); known && known->holds) todo.emplace_back(a, b);
 	FleetResult out;
 	size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0;
 	const PreparedMaps prepared = prepareAll(maps, hints.prepared, aligner, params.threads);
+	const std::vector<ContentCorners> corners = contentCornersOf(maps);
+	// A pair's promise, computed when first asked: an earlier merged result
+	// first (tracking it is cheap), then the most feature inliers.
+	std::map<PairKey, double> promises;
+	const FeatureParams feature_params = aligner.options.featureParams();
+	auto promise = [&](size_t a, size_t b) {
+		const auto [it, fresh] = promises.try_emplace(keyOf(a, b), 0.0);
+		if (fresh)
+		{
+			const auto known = hints.known ? hints.known(a, b) : std::nullopt;
+			it->second = known && known->edge.merged ? std::numeric_limits<double>::infinity()
+													 : promiseOf(*prepared[a], *prepared[b], feature_params);
+		}
+		return it->second;
+	};
+	std::vector<size_t> tries_since_placed(n, 0);
 	bool first_round = true;
 	while (!todo.empty())
 	{
+		std::vector<bool> placed_before(n);
+		for (size_t m = 0; m < n; ++m) placed_before[m] = !out.maps.empty() && out.maps[m].placed;
 		// What still holds from before is taken; the rest is aligned, from its
 		// earlier transform first where it had one.
 		std::vector<PairToAlign> to_align;
 		for (const auto& [to, from] : todo)
 		{
-			done.insert(key(to, from));
+			done.insert(keyOf(to, from));
 			std::optional<FleetHints::Known> known;
 			if (hints.known) known = hints.known(to, from);
 			if (known && known->holds)
@@ -331,24 +484,14 @@ FleetResult placeFleet(
 		const auto aligned = alignPairs(maps, prepared, to_align, aligner, params.threads, hints.deadline, first_must_start);
 		for (size_t k = 0; k < aligned.size(); ++k)
 		{
+			for (size_t m : {to_align[k].to, to_align[k].from}) tries_since_placed[m] += placed_before[m];
 			if (aligned[k]) edges.push_back(*aligned[k]), ++pairs_aligned;
 			else if (to_align[k].stand_in) edges.push_back(*to_align[k].stand_in), ++pairs_deferred;
 			else ++pairs_deferred;
 		}
-		out = placeFromPairs(maps, reference, edges, params);
+		out = placeFromPairs(maps, corners, reference, edges, params);
 		edges = out.edges;  // with the dropped marks
-		// Next round: the pairs that can still matter, those with a map that is
-		// not yet placed surely (a better path, or a first one, may go through
-		// any other map). Placed maps go first: they can carry a new one.
-		todo.clear();
-		auto settled = [&](size_t m) { return out.maps[m].placed && out.maps[m].confidence >= params.settled_confidence; };
-		for (size_t a = 0; a < n; ++a)
-			for (size_t b = a + 1; b < n; ++b)
-			{
-				if (done.count(key(a, b)) || (settled(a) && settled(b))) continue;
-				const bool b_first = out.maps[b].placed && !out.maps[a].placed;
-				todo.emplace_back(b_first ? b : a, b_first ? a : b);
-			}
+		todo = nextPairs(reference, {out, done, tries_since_placed}, promise, params, params.threads);
 	}
 	out.pairs_aligned = pairs_aligned;
 	out.pairs_reused = pairs_reused;

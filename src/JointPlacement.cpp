@@ -1,8 +1,6 @@
-#include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/JointPlacement.h>
 
 #include <Eigen/Dense>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <array>
@@ -12,21 +10,6 @@ namespace multires_map_merge
 {
 namespace
 {
-using Corners = std::array<Eigen::Vector2d, 4>;
-
-/** The corners of the box around what a map saw (its known cells), in its
- * frame: where its placement matters; the grid's padding does not. */
-Corners contentCorners(const GridInFrame& map)
-{
-	std::vector<cv::Point> known;
-	cv::findNonZero(toClassImage(map.grid) != kUnknown, known);
-	cv::Rect box(0, 0, int(map.grid.getSizeX()), int(map.grid.getSizeY()));
-	if (!known.empty()) box = cv::boundingRect(known);
-	const Similarity2D cells = map.cellToMapFrame();
-	const double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
-	return {cells({x0, y0}), cells({x1, y0}), cells({x0, y1}), cells({x1, y1})};
-}
-
 /** The 2×2 block of z ↦ a·z as a function of a = (re, im): a·z is linear in a. */
 Eigen::Matrix2d timesPoint(const Eigen::Vector2d& z)
 {
@@ -45,17 +28,12 @@ double coarseCellInReference(
 	return coarse * placements[e.to].in_reference.scale;
 }
 
-double cornersRms(const Corners& corners, const Similarity2D& a, const Similarity2D& b)
-{
-	double se = 0;
-	for (const auto& c : corners) se += (a(c) - b(c)).squaredNorm();
-	return std::sqrt(se / corners.size());
-}
 }  // namespace
 
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, double max_move_cells, const JointPlacementParams& params)
+	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners, double max_move_cells,
+	const JointPlacementParams& params)
 {
 	const size_t n = maps.size();
 	std::vector<std::optional<Similarity2D>> out(n);
@@ -72,9 +50,6 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 	}
 	if (unknowns == 0 || used.size() <= size_t(unknowns)) return out;  // a tree: nothing to balance
 
-	std::vector<Corners> corners(n);
-	for (size_t m = 0; m < n; ++m)
-		if (placements[m].placed) corners[m] = contentCorners(maps[m]);
 	const int rows = int(used.size()) * 8, cols = 4 * unknowns;
 	std::vector<double> weight(used.size(), 1.0);
 	Eigen::VectorXd x;

@@ -4,6 +4,7 @@
 // pair and the TurtleBot test area; the acceptance sites F5 and KPT4A are
 // measured by the benchmark.
 #include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/MapIO.h>
 
@@ -161,6 +162,50 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 			}
 		}
 	}
+}
+
+/** A real fleet: HIH's four maps recorded at three cell sizes (×1, ×2, ×1.4,
+ * all stated 0.05 m), placed in one call. Every map lands right; the joint
+ * refinement with every confident pair puts the worst map no farther than
+ * its one path alone does, and a map reached through a chain lands as close
+ * as the maps placed directly. */
+TEST(RealMaps, HalmstadFleetAtMixedCellSizesPlacesAChainedMapAsCloseAsADirectOne)
+{
+	REQUIRE_HALMSTAD();
+	const std::vector<std::string> names = halmstad()->sensorMaps("HIH");
+	ASSERT_EQ(names.size(), 4u);
+	const double factors[] = {1.0, 2.0, 1.4, 1.0};
+	std::vector<GridInFrame> maps, fine;
+	for (size_t i = 0; i < names.size(); ++i)
+	{
+		fine.push_back(loadGridMap(halmstad()->yaml(names[i], dir())));
+		maps.push_back(factors[i] == 1.0 ? fine.back()
+										 : loadGridMap(multires_bench::coarserYaml(*halmstad(), names[i], factors[i], dir())));
+	}
+	FleetParams tree_alone;
+	tree_alone.joint_refinement = false;
+	const FleetResult joint = placeFleet(maps, 0, CScalingGridMapAligner());
+	const FleetResult tree = placeFromPairs(maps, 0, joint.edges, tree_alone);
+	const int ref_rows = int(maps[0].grid.getSizeY());
+	auto displacement = [&](const FleetResult& r, size_t m) {
+		const Similarity2D fine_in_ref = r.maps[m].in_reference.compose(multires_bench::fineToCoarse(
+			factors[m], int(fine[m].grid.getSizeY()), int(maps[m].grid.getSizeY())));
+		const auto judged = multires_bench::judge(fine_in_ref, *halmstad()->pair(names[m], names[0]), fine[m], ref_rows);
+		EXPECT_TRUE(judged.right) << names[m] << ": " << judged.mean_displacement_px << " px";
+		return judged.mean_displacement_px;
+	};
+	double worst_joint = 0, worst_tree = 0, worst_direct = 0, worst_chained = 0;
+	for (size_t m = 1; m < maps.size(); ++m)
+	{
+		ASSERT_TRUE(joint.maps[m].placed) << names[m] << ": " << joint.maps[m].message;
+		const double d = displacement(joint, m);
+		worst_joint = std::max(worst_joint, d);
+		worst_tree = std::max(worst_tree, displacement(tree, m));
+		double& worst = joint.maps[m].parent == 0 ? worst_direct : worst_chained;
+		worst = std::max(worst, d);
+	}
+	EXPECT_LE(worst_joint, worst_tree + 0.5);
+	EXPECT_LE(worst_chained, std::max(worst_direct, 5.0) * 1.25);
 }
 
 TEST(RealMaps, HalmstadDifferentBuildingsAreRefused)

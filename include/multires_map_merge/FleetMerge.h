@@ -10,7 +10,9 @@
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GridInFrame.h>
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <array>
 #include <chrono>
 #include <functional>
 #include <optional>
@@ -49,12 +51,20 @@ struct FleetParams
 {
 	/** Pairs aligned at once (0: one per hardware thread). */
 	unsigned threads = 0;
-	/** A map placed this surely needs no more pairs: the pairs between
-	 * settled maps are skipped. */
+	/** A map placed this surely by two confident pairs needs no more: the
+	 * other pairs are skipped. Pairs are tried most promising first (feature
+	 * inliers); a map not placed tries every pair it has. */
 	double settled_confidence = 0.95;
-	/** A cycle whose composed transform moves a map's corners by more than
-	 * this many cells of the coarser map (RMS) is contradictory. */
-	double cycle_tolerance_cells = 3.0;
+	/** A placed map not yet sure (above) tries this many more pairs for
+	 * another confident path (the cycle check's and the joint refinement's). */
+	size_t second_path_tries = 2;
+	/** A cycle whose composed transform moves the corners of what a map saw
+	 * by more than this many cells of the coarser map (RMS) is contradictory.
+	 * The decision's own bound between one answer and a rival
+	 * (DecisionParams::distinct_shift): independent maps bend, so right
+	 * pairs of one building disagree by up to 35 cells on Halmstad E5; a
+	 * wrong pair places a map elsewhere. */
+	double cycle_tolerance_cells = DecisionParams{}.distinct_shift;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */
@@ -111,6 +121,14 @@ struct FleetResult
  * put the four corners of `map`'s grid: how far apart two placements of a
  * map are. */
 double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
+
+/** The corners of the box around what a map saw (its known cells), in its
+ * frame: where its placement matters (a grid's padding of unknown space
+ * would count a small turn many cells away from anything seen). */
+using ContentCorners = std::array<Eigen::Vector2d, 4>;
+ContentCorners contentCorners(const GridInFrame& map);
+/** RMS distance between where two transforms put the corners. */
+double cornersRms(const ContentCorners& corners, const Similarity2D& a, const Similarity2D& b);
 
 /** The placement from pairs already aligned (placeFleet's step after each
  * round of alignments): the maximum spanning tree from the reference, cycles

@@ -25,13 +25,15 @@ struct JointPlacementParams
 
 /** Every placed map's pose in the reference's frame (`in_reference` of each
  * placed map; the reference fixed) refined from every confident pair that is
- * not dropped and joins two placed maps. A map whose refined pose moves its
- * content by more than `max_move_cells` from its tree placement keeps the
- * tree's (the cycle check admits pairs within that much of each other: a
+ * not dropped and joins two placed maps, each weighed at the corners of its
+ * `from` map's content (`corners`, one per map). A map whose refined pose
+ * moves its content by more than `max_move_cells` from its tree placement
+ * keeps the tree's (the cycle check admits pairs within that much of each other: a
  * larger move means the pairs do not support one placement). Returns, per
  * map, the refined pose, or nothing where the tree's stays. */
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, double max_move_cells, const JointPlacementParams& params = {});
+	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners, double max_move_cells,
+	const JointPlacementParams& params = {});
 
 }  // namespace multires_map_merge
