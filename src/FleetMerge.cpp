@@ -38,16 +38,22 @@ double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity
 	return std::sqrt(se / 4);
 }
 
-ContentCorners contentCorners(const GridInFrame& map)
+namespace
+{
+/** contentCorners from the map's class image (GridImage.h). */
+ContentCorners contentCorners(const GridInFrame& map, const cv::Mat& classes)
 {
 	std::vector<cv::Point> known;
-	cv::findNonZero(toClassImage(map.grid) != kUnknown, known);
+	cv::findNonZero(classes != kUnknown, known);
 	cv::Rect box(0, 0, int(map.grid.getSizeX()), int(map.grid.getSizeY()));
 	if (!known.empty()) box = cv::boundingRect(known);
 	const Similarity2D cells = map.cellToMapFrame();
 	const double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
 	return {cells({x0, y0}), cells({x1, y0}), cells({x0, y1}), cells({x1, y1})};
 }
+}  // namespace
+
+ContentCorners contentCorners(const GridInFrame& map) { return contentCorners(map, toClassImage(map.grid)); }
 
 double cornersRms(const ContentCorners& corners, const Similarity2D& a, const Similarity2D& b)
 {
@@ -300,18 +306,15 @@ struct FleetProgress
 	const std::vector<size_t>& tries_since_placed;
 };
 
-/** Whether map m still wants pairs: not placed; or placed by fewer than two
- * kept confident pairs, or less surely than settled, and not yet given
- * `second_path_tries` more pairs to find another path. */
+/** Whether map m still wants pairs: not placed; or placed less surely than
+ * settled and not yet given `second_path_tries` more pairs to find a surer
+ * path. */
 bool wantsPairs(size_t m, size_t reference, const FleetProgress& f, const FleetParams& params)
 {
 	if (m == reference) return false;
 	const FleetPlacement& p = f.placed.maps[m];
 	if (!p.placed) return true;
-	size_t kept = 0;
-	for (const FleetEdge& e : f.placed.edges) kept += (e.from == m || e.to == m) && e.merged && !e.dropped;
-	const bool sure = kept >= 2 && p.confidence >= params.settled_confidence;
-	return !sure && f.tries_since_placed[m] < params.second_path_tries;
+	return p.confidence < params.settled_confidence && f.tries_since_placed[m] < params.second_path_tries;
 }
 
 /** The next round: each map that wants pairs takes its most promising one
@@ -353,10 +356,15 @@ PairList nextPairs(
 	}
 }
 
-std::vector<ContentCorners> contentCornersOf(const std::vector<GridInFrame>& maps)
+/** Each map's content corners, from its prepared class image where it has one. */
+std::vector<ContentCorners> contentCornersOf(const std::vector<GridInFrame>& maps, const PreparedMaps& prepared = {})
 {
 	std::vector<ContentCorners> out;
-	for (const auto& m : maps) out.push_back(contentCorners(m));
+	for (size_t m = 0; m < maps.size(); ++m)
+	{
+		const bool have = m < prepared.size() && prepared[m] && !prepared[m]->classes.empty();
+		out.push_back(have ? contentCorners(maps[m], prepared[m]->classes) : contentCorners(maps[m]));
+	}
 	return out;
 }
 
@@ -425,7 +433,7 @@ FleetResult placeFleet(
 	FleetResult out;
 	size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0;
 	const PreparedMaps prepared = prepareAll(maps, hints.prepared, aligner, params.threads);
-	const std::vector<ContentCorners> corners = contentCornersOf(maps);
+	const std::vector<ContentCorners> corners = contentCornersOf(maps, prepared);
 	// A pair's promise, computed when first asked: an earlier merged result
 	// first (tracking it is cheap), then the most feature inliers.
 	std::map<PairKey, double> promises;

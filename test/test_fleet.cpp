@@ -124,10 +124,10 @@ TEST(Fleet, PlacesEveryRobotOfTheBuildingAndKeepsTheOtherBuildingOut)
 	// placed through another robot, not directly.
 	EXPECT_GT(r.maps[3].parent, 0) << r.maps[3].message;
 	EXPECT_EQ(r.pairs_aligned + r.pairs_skipped, f.maps.size() * (f.maps.size() - 1) / 2);
-	// Every confident pair here is right (each robot lands within 2 cells), so
-	// none contradicts the others around a cycle: all of them place the maps.
-	for (const auto& e : r.edges)
-		EXPECT_FALSE(e.merged && e.dropped) << e.from << " -> " << e.to << ": " << e.describe();
+	// Placed through a chain, it lands as close as the robots placed directly.
+	double worst_direct = 0;
+	for (size_t m : {1, 2}) worst_direct = std::max(worst_direct, errorCoarseCells(f, m, r.maps[m].in_reference));
+	EXPECT_LE(errorCoarseCells(f, 3, r.maps[3].in_reference), std::max(0.5, 1.5 * worst_direct)) << r.maps[3].message;
 }
 
 TEST(Fleet, FusesThePlacedMapsOnTheReferenceLattice)

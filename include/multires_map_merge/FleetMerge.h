@@ -51,20 +51,20 @@ struct FleetParams
 {
 	/** Pairs aligned at once (0: one per hardware thread). */
 	unsigned threads = 0;
-	/** A map placed this surely by two confident pairs needs no more: the
-	 * other pairs are skipped. Pairs are tried most promising first (feature
-	 * inliers); a map not placed tries every pair it has. */
+	/** A map placed this surely needs no more pairs: the other pairs are
+	 * skipped. Pairs are tried most promising first (feature inliers); a map
+	 * not placed tries every pair it has. */
 	double settled_confidence = 0.95;
-	/** A placed map not yet sure (above) tries this many more pairs for
-	 * another confident path (the cycle check's and the joint refinement's). */
+	/** A placed map not yet settled tries this many more pairs, most
+	 * promising first, for a surer path. */
 	size_t second_path_tries = 2;
 	/** A cycle whose composed transform moves the corners of what a map saw
 	 * by more than this many cells of the coarser map (RMS) is contradictory.
-	 * The decision's own bound between one answer and a rival
-	 * (DecisionParams::distinct_shift): independent maps bend, so right
-	 * pairs of one building disagree by up to 35 cells on Halmstad E5; a
-	 * wrong pair places a map elsewhere. */
-	double cycle_tolerance_cells = DecisionParams{}.distinct_shift;
+	 * Tight on purpose: two pairs of precise maps 4 cells apart means one is
+	 * off, and the joint refinement would land between them. Right pairs of
+	 * bent real maps disagree by 2–35 cells, so there the check keeps the
+	 * tree's pairs (docs/method.md, limit). */
+	double cycle_tolerance_cells = 3.0;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */
