@@ -21,4 +21,7 @@ export LSAN_OPTIONS="suppressions=$here/test/lsan.supp:print_suppressions=0"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd "$build"
-ctest --output-on-failure -E 'bench_|soak'  # the benchmark's runs and the memory soak (ASan's allocator is not the node's) run un-instrumented in the main suite
+# The benchmark's runs, the memory soak (ASan's allocator is not the node's) and
+# the install test (an uninstrumented example cannot load instrumented
+# libraries) run un-instrumented in the main suite.
+ctest --output-on-failure -E 'bench_|soak|install_'

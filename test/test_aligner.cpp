@@ -314,6 +314,57 @@ TEST(Config, IniRoundTripAndOverride)
 	EXPECT_DOUBLE_EQ(c.decision.min_confidence, 0.8);
 	EXPECT_DOUBLE_EQ(c.xi_min, 0.35);
 }
+
+// Every parameter of the one list: a value other than its default survives an
+// ini file, and one outside its range is refused naming its key.
+TEST(Config, EveryListedParameterRoundTripsAndIsRangeChecked)
+{
+	using P = CScalingGridMapAligner::TConfigParams;
+	const P defaults;
+	P changed;
+	for (const auto& f : alignerParamFields())
+		std::visit(
+			[&](auto member) {
+				using T = std::remove_reference_t<decltype(changed.*member)>;
+				if constexpr (std::is_same_v<T, bool>) changed.*member = !(defaults.*member);
+				else
+				{
+					changed.*member = static_cast<T>(f.hi > f.lo + 1 ? std::floor(f.lo + 1) : (f.lo + f.hi) / 2);
+					if (changed.*member == defaults.*member) changed.*member = static_cast<T>(f.hi);
+				}
+				EXPECT_NE(changed.*member, defaults.*member) << f.key;
+			},
+			f.member);
+	ASSERT_EQ(changed.invalidReason(), "");
+	const std::string path = ::testing::TempDir() + "/aligner_every_key.ini";
+	{
+		mrpt::config::CConfigFile out(path);
+		changed.saveToConfigFile(out, "aligner");
+	}
+	P loaded;
+	loaded.loadFromConfigFile(mrpt::config::CConfigFile(path), "aligner");
+	for (const auto& f : alignerParamFields())
+		std::visit([&](auto member) { EXPECT_EQ(loaded.*member, changed.*member) << f.key; }, f.member);
+
+	for (const auto& f : alignerParamFields())
+	{
+		if (std::holds_alternative<bool P::*>(f.member)) continue;
+		mrpt::config::CConfigFileMemory bad;
+		const std::string too_big = std::to_string(static_cast<long long>(f.hi * 2 + 1));  // an int key reads it too
+		bad.write("aligner", f.key, too_big);
+		try
+		{
+			P().loadFromConfigFile(bad, "aligner");
+			ADD_FAILURE() << f.key << " = " << too_big << " was taken";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(f.key), std::string::npos) << e.what();
+		}
+	}
+	// The ROS nodes read exactly these keys, the aligner's then the decision's.
+	EXPECT_EQ(alignerParamKeys().size(), alignerParamFields().size() + decisionParamFields().size());
+}
 }  // namespace
 
 TEST(Carmen, HundredEightyBeamScansSpanHalfACircle)

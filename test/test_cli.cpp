@@ -1,10 +1,12 @@
 // gridmap-merge end to end on real data: every input format, outputs, JSON
 // against ground truth, exit codes.
+#include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include <array>
@@ -192,4 +194,25 @@ TEST(Cli, UnwritableOutputsExitTwoBeforeAnyWork)
 	const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
 	EXPECT_NE(text.find("a_folder': exists and is not a file"), std::string::npos) << text;
 	EXPECT_FALSE(fs::exists(d + "/x.png"));
+}
+
+// README's parameter table is the one list as gridmap-merge prints it, and
+// --write-config writes every key, which loads back as the defaults.
+TEST(Cli, ParametersAsReadmeListsThemAndWrittenAsAnIni)
+{
+	const CliRun table = runCli("--parameters");
+	ASSERT_EQ(table.exit_code, 0) << table.output;
+	EXPECT_NE(slurp(MMM_README).find(table.output), std::string::npos)
+		<< "README.md's parameter table differs from `gridmap-merge --parameters`; paste it:\n" << table.output;
+
+	const std::string ini = dir() + "/written.ini";
+	const CliRun written = runCli("--write-config " + ini);
+	ASSERT_EQ(written.exit_code, 0) << written.output;
+	const std::string text = slurp(ini);
+	for (const std::string& key : alignerParamKeys()) EXPECT_NE(text.find(key + " "), std::string::npos) << key;
+	CScalingGridMapAligner::TConfigParams loaded;
+	loaded.loadFromConfigFile(mrpt::config::CConfigFile(ini), "aligner");
+	EXPECT_EQ(loaded.xi_min, CScalingGridMapAligner::TConfigParams().xi_min);
+	EXPECT_EQ(loaded.decision.threshold, CScalingGridMapAligner::TConfigParams().decision.threshold);
+	EXPECT_EQ(runCli("--write-config " + ini + " " + ini).exit_code, 2) << "maps with --write-config";
 }

@@ -31,6 +31,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <variant>
+#include <vector>
 
 namespace multires_map_merge
 {
@@ -307,5 +309,27 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	 * score (NaN with none judged in full). */
 	double mirrorPass(const TPreparedMap& ref, const TPreparedMap& other, pair_search::SearchState& search) const;
 };
+
+/** One aligner parameter: its ini key (section [aligner]; the ROS parameter of
+ * the same name), its member, its valid range (0 also valid where it turns the
+ * step off) and what it sets. Loading, saving, validation, the ROS nodes' keys
+ * and README's table (gridmap-merge --parameters) all read this one list; the
+ * decision's parameters are decisionParamFields(). */
+struct AlignerParamField
+{
+	using Params = CScalingGridMapAligner::TConfigParams;
+	const char* key;
+	std::variant<int Params::*, double Params::*, bool Params::*> member;
+	double lo, hi;
+	bool zero_turns_off;
+	const char* description;
+};
+const std::vector<AlignerParamField>& alignerParamFields();
+
+/** Every ini key, the aligner's and then the decision's, in the saved order. */
+std::vector<std::string> alignerParamKeys();
+
+/** README's parameter table: key, default, valid range, description. */
+std::string alignerParamsMarkdown();
 
 }  // namespace multires_map_merge

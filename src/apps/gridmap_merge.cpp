@@ -190,6 +190,12 @@ int main(int argc, char** argv)
 		"", "png", "write an overlay PNG (black both, blue REF only, red OTHER only; a colour per map for 3+)", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> config_arg(
 		"", "config", "aligner parameters, section [aligner] of an MRPT ini file", false, "", "FILE.ini", cmd);
+	TCLAP::ValueArg<std::string> write_config_arg(
+		"", "write-config",
+		"write every aligner parameter (defaults, or --config's) with its meaning as an ini file, and exit", false,
+		"", "FILE.ini", cmd);
+	TCLAP::SwitchArg parameters_arg(
+		"", "parameters", "print every aligner parameter: key, default, valid range, meaning (README's table)", cmd);
 	TCLAP::SwitchArg metadata_arg(
 		"", "use-resolution-metadata", "use the stated resolutions as a scale prior", cmd);
 	TCLAP::ValueArg<std::string> outres_arg(
@@ -209,13 +215,20 @@ int main(int argc, char** argv)
 		for (const auto& m : maps_arg.getValue())  // TCLAP takes unknown flags as positionals
 			if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
 		// "--json --png x.png" wrote the JSON to a file named "--png".
-		for (const auto* a : {&json_arg, &out_arg, &png_arg, &config_arg, &bag_arg})
+		for (const auto* a : {&json_arg, &out_arg, &png_arg, &config_arg, &bag_arg, &write_config_arg})
 			if (a->isSet() && !isFileName(a->getValue()))
 				throw UsageError("--" + a->getName() + " needs a file name, not '" + a->getValue() + "'");
+		if (parameters_arg.getValue())
+		{
+			std::cout << alignerParamsMarkdown();
+			return kMerged;
+		}
 		const bool bag_mode = bag_arg.isSet();
+		if (write_config_arg.isSet() && (bag_mode || !maps_arg.getValue().empty()))
+			throw UsageError("--write-config takes no maps: it writes the parameters and exits");
 		if (bag_mode && !maps_arg.getValue().empty())
 			throw UsageError("give either --bag FILE --topics A B or map files, not both");
-		if (!bag_mode && maps_arg.getValue().size() < 2)
+		if (!bag_mode && !write_config_arg.isSet() && maps_arg.getValue().size() < 2)
 			throw UsageError("give two or more map files (REF OTHER [OTHER ...]), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
 		if (!bag_mode && topics_arg.isSet()) throw UsageError("--topics needs --bag");
 		if (bag_mode && topics_arg.getValue().size() < 2)
@@ -229,6 +242,15 @@ int main(int argc, char** argv)
 			aligner.options.loadFromConfigFile(mrpt::config::CConfigFile(config_arg.getValue()), "aligner");
 		}
 		if (metadata_arg.getValue()) aligner.options.use_resolution_metadata = true;
+		if (write_config_arg.isSet())
+		{
+			checkWritable(write_config_arg.getName(), write_config_arg.getValue());
+			mrpt::config::CConfigFile ini(write_config_arg.getValue());
+			aligner.options.saveToConfigFile(ini, "aligner");
+			ini.writeNow();
+			std::cout << "wrote " << write_config_arg.getValue() << "\n";
+			return kMerged;
+		}
 		if (verbose_arg.getValue()) aligner.setMinLoggingLevel(mrpt::system::LVL_DEBUG);
 		if (!std::isfinite(smres_arg.getValue()) || !(smres_arg.getValue() > 0))
 			throw UsageError("--simplemap-resolution must be metres > 0");

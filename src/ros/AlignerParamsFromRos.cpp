@@ -2,7 +2,6 @@
 
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
-#include <mrpt/system/string_utils.h>
 #include <ros/console.h>
 #include <ros/param.h>
 
@@ -15,17 +14,6 @@ namespace multires_map_merge::ros1
 {
 namespace
 {
-/** The ini keys, as the parameters write them: one list, kept by TConfigParams. */
-std::vector<std::string> alignerKeys()
-{
-	mrpt::config::CConfigFileMemory ini;
-	CScalingGridMapAligner::TConfigParams().saveToConfigFile(ini, "aligner");
-	std::vector<std::string> keys;
-	ini.getAllKeys("aligner", keys);
-	for (auto& k : keys) k = mrpt::system::trim(k);  // MRPT pads keys to align the values
-	return keys;
-}
-
 std::string asIniValue(const std::string& key, XmlRpc::XmlRpcValue& v)
 {
 	std::ostringstream s;
@@ -59,7 +47,7 @@ CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
 		params.loadFromConfigFile(mrpt::config::CConfigFile(config_file), section);
 	}
 
-	const std::vector<std::string> keys = alignerKeys();
+	const std::vector<std::string> keys = alignerParamKeys();
 	mrpt::config::CConfigFileMemory overrides;
 	for (const auto& key : keys)
 	{
