@@ -307,14 +307,14 @@ struct FleetProgress
 };
 
 /** Whether map m still wants pairs: not placed; or placed less surely than
- * settled and not yet given `second_path_tries` more pairs to find a surer
+ * settled and not yet given `unsettled_tries` more pairs to find a surer
  * path. */
 bool wantsPairs(size_t m, size_t reference, const FleetProgress& f, const FleetParams& params)
 {
 	if (m == reference) return false;
 	const FleetPlacement& p = f.placed.maps[m];
 	if (!p.placed) return true;
-	return p.confidence < params.settled_confidence && f.tries_since_placed[m] < params.second_path_tries;
+	return p.confidence < params.settled_confidence && f.tries_since_placed[m] < params.unsettled_tries;
 }
 
 /** The next round: each map that wants pairs takes its most promising one

@@ -57,13 +57,13 @@ struct FleetParams
 	double settled_confidence = 0.95;
 	/** A placed map not yet settled tries this many more pairs, most
 	 * promising first, for a surer path. */
-	size_t second_path_tries = 2;
+	size_t unsettled_tries = 2;
 	/** A cycle whose composed transform moves the corners of what a map saw
 	 * by more than this many cells of the coarser map (RMS) is contradictory.
 	 * Tight on purpose: two pairs of precise maps 4 cells apart means one is
 	 * off, and the joint refinement would land between them. Right pairs of
-	 * bent real maps disagree by 2–35 cells, so there the check keeps the
-	 * tree's pairs (docs/method.md, limit). */
+	 * bent real maps disagree by 2–35 cells, so there the check drops most
+	 * redundant pairs, keeping the tree's (docs/method.md, limit). */
 	double cycle_tolerance_cells = 3.0;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
