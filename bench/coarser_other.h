@@ -17,6 +17,9 @@
 
 namespace multires_bench
 {
+/** OTHER's cells this many times larger (issue 35: 2× and 3.3×). */
+inline const std::vector<double> kCoarserFactors = {2.0, 3.3};
+
 struct CoarserRun
 {
 	std::string site, ref, other;

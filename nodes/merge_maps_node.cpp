@@ -17,15 +17,15 @@ int main(int argc, char** argv)
 	ros::NodeHandle nh, pnh("~");
 
 	std::unique_ptr<ros1::MergeMapsService> service;
+	const char *threads_key = "concurrent_requests", *max_cells_key = "max_merged_cells";  // the node's own
 	int threads = 2, max_merged_cells = 1 << 26;
 	try
 	{
-		pnh.param("concurrent_requests", threads, threads);
-		pnh.param("max_merged_cells", max_merged_cells, max_merged_cells);
-		if (threads < 1) throw std::invalid_argument("~concurrent_requests must be >= 1");
-		if (max_merged_cells < 1) throw std::invalid_argument("~max_merged_cells must be >= 1");
-		service = std::make_unique<ros1::MergeMapsService>(
-			ros1::alignerParamsFromRos(pnh, {"concurrent_requests", "max_merged_cells"}));
+		pnh.param(threads_key, threads, threads);
+		pnh.param(max_cells_key, max_merged_cells, max_merged_cells);
+		if (threads < 1) throw std::invalid_argument(std::string("~") + threads_key + " must be >= 1");
+		if (max_merged_cells < 1) throw std::invalid_argument(std::string("~") + max_cells_key + " must be >= 1");
+		service = std::make_unique<ros1::MergeMapsService>(ros1::alignerParamsFromRos(pnh, {threads_key, max_cells_key}));
 		service->max_merged_cells = static_cast<size_t>(max_merged_cells);
 	}
 	catch (const std::exception& e)

@@ -1,0 +1,24 @@
+#pragma once
+// The decision's calibration data (multires_bench --calibration-data):
+// every candidate of every pair the decision is fitted on, with its evidence
+// and whether it was right, into candidates.csv for
+// scripts/calibrate_decision.py. Calibration sites only (Halmstad E5, HIH),
+// their cross-site negatives in both orders, CARMEN negatives, mirror images,
+// the live fleet's growing maps and OTHER recorded coarser.
+
+#include "context.h"
+
+namespace multires_bench
+{
+/** Which parts; all of them when none is set. */
+struct CalibrationParts
+{
+	bool extra_negatives = false, live_pairs = false, coarser_pairs = false;
+	size_t negatives_per_map = 8;
+};
+
+/** Writes the candidates of every part asked for to ctx.candidates (which
+ * must be set; its options refine every hypothesis). */
+void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts);
+
+}  // namespace multires_bench

@@ -1,0 +1,101 @@
+#include "halmstad_pairs.h"
+
+#include <multires_map_merge/Finish.h>
+#include <multires_map_merge/MapIO.h>
+
+#include <mrpt/system/CTicTac.h>
+
+#include <filesystem>
+#include <functional>
+#include <iostream>
+
+namespace multires_bench
+{
+namespace fs = std::filesystem;
+using namespace multires_map_merge;
+
+HalmstadRun runHalmstadPair(
+	const BenchContext& ctx, const HalmstadData& data, const std::string& ref, const std::string& other,
+	const std::string& dir, double mrpt_limit_s)
+{
+	HalmstadRun run;
+	run.site = ref.substr(0, ref.find('_'));
+	run.ref = ref, run.other = other;
+	run.positive = run.site == other.substr(0, other.find('_'));
+	// Calibration data (the issue's): E5 and HIH positives; negatives of an E5 map against another site.
+	run.calibration = run.positive ? isCalibrationSite(run.site) : (ref.rfind("E5_", 0) == 0 || other.rfind("E5_", 0) == 0);
+	const GridInFrame ref_map = loadGridMap(data.yaml(ref, dir)), other_map = loadGridMap(data.yaml(other, dir));
+	const HalmstadPair* truth = run.positive ? data.pair(other, ref) : nullptr;
+	mrpt::system::CTicTac clock;
+	const auto r = ctx.aligner().alignScaled(ref_map, other_map);
+	run.seconds = clock.Tac();
+	run.merged = r.success;
+	run.confidence = r.confidence;
+	run.message = r.message;
+	const int ref_rows = static_cast<int>(ref_map.grid.getSizeY());
+	if (truth && r.candidates.size()) run.outcome = judge(r.metric, *truth, other_map, ref_rows);
+	if (mrpt_limit_s > 0)
+	{
+		run.mrpt = mrptWithTimeLimit(ctx.self, data.yaml(ref, dir), data.yaml(other, dir), mrpt_limit_s);
+		if (truth && run.mrpt.aligned) run.mrpt_right = judge(run.mrpt.metric, *truth, other_map, ref_rows).right;
+	}
+	// Each candidate judged as it would be reported (the aligner's finish for
+	// maps that bend, finishBent): what a user gets if the decision picks it.
+	CScalingGridMapAligner::PreparedMapPtr ref_prepared, other_prepared;
+	if (truth && ctx.candidates)
+		ref_prepared = ctx.aligner().prepare(ref_map.grid), other_prepared = ctx.aligner().prepare(other_map.grid);
+	const auto error_of = [&](const Similarity2D& cells) {
+		const HalmstadOutcome o = judge(candidateMetric(ref_map, cells, other_map), *truth, other_map, ref_rows);
+		return std::pair<double, bool>{o.mean_displacement_px, o.right};
+	};
+	writeCandidates(ctx, run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
+		const auto& o = ctx.options;
+		return ref_prepared
+			? finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells, o.finishParams(), o.decision)
+			: c.cells;
+	});
+	std::cout << "halmstad " << ref << " <- " << other << ": "
+			  << (run.positive ? (run.merged ? (run.outcome.right ? "merged right" : "MERGED WRONG") : "refused")
+						   : (run.merged ? "MERGED (false)" : "refused (negative)"))
+			  << " disp " << run.outcome.mean_displacement_px << " px, " << run.seconds << " s" << std::endl;
+	return run;
+}
+
+std::vector<HalmstadRun> runHalmstad(
+	const BenchContext& ctx, const HalmstadData& data, const std::vector<std::string>& sites, size_t negatives_per_map)
+{
+	const std::string dir = ctx.tempDir("halmstad");
+	std::vector<HalmstadRun> runs;
+	for (const auto& site : sites)
+	{
+		size_t k = 0;
+		// MRPT beside on a few pairs per site (13 s a pair; killed at 30 s).
+		for (const auto& p : data.unorderedPairs(site))
+			runs.push_back(runHalmstadPair(ctx, data, p.dst, p.src, dir, k++ % 16 == 0 ? 30.0 : 0.0));
+	}
+	if (negatives_per_map)
+	{
+		std::vector<std::string> all;
+		for (const auto& site : data.sites())
+			for (const auto& m : data.sensorMaps(site)) all.push_back(m);
+		for (const auto& site : sites)
+			for (const auto& ref : data.sensorMaps(site))
+			{
+				size_t taken = 0;
+				// Walk the other sites' maps from a per-map offset, so the
+				// negatives spread over every site and map.
+				const size_t start = std::hash<std::string>()(ref) % all.size();
+				for (size_t k = 0; k < all.size() && taken < negatives_per_map; ++k)
+				{
+					const std::string& other = all[(start + k * 7) % all.size()];
+					if (other.substr(0, other.find('_')) == site) continue;
+					runs.push_back(runHalmstadPair(ctx, data, ref, other, dir));
+					++taken;
+				}
+			}
+	}
+	fs::remove_all(dir);
+	return runs;
+}
+
+}  // namespace multires_bench

@@ -1,0 +1,41 @@
+#pragma once
+// Real independent maps (Halmstad Robot Maps, ../shared/data/halmstad): every
+// same-site sensor pair judged against the annotation, cross-site negatives,
+// MRPT beside on a sample.
+
+#include "context.h"
+#include "halmstad.h"
+#include "scaling.h"
+
+#include <string>
+#include <vector>
+
+namespace multires_bench
+{
+struct HalmstadRun
+{
+	std::string site, ref, other;
+	bool positive = true;  //!< same site (annotated) or a cross-site negative
+	bool calibration = false;  //!< a calibration site's pair (may be tuned on)
+	bool merged = false;
+	HalmstadOutcome outcome;  //!< of the reported transform (positives)
+	double seconds = 0, confidence = 0;
+	std::string message;
+	LimitedMrpt mrpt;
+	bool mrpt_right = false;
+};
+
+/** Aligns REF ← OTHER from map_server files; for positives judges the result
+ * against the annotation. Every candidate goes to ctx.candidates with its
+ * features and whether it was right: the data the decision is calibrated on. */
+HalmstadRun runHalmstadPair(
+	const BenchContext& ctx, const HalmstadData& data, const std::string& ref, const std::string& other,
+	const std::string& dir, double mrpt_limit_s = 0);
+
+/** The issue's pair sets: every unordered same-site pair (REF = the later
+ * map), and cross-site negatives: each map of one site against maps of the
+ * others, `negatives_per_map` each. */
+std::vector<HalmstadRun> runHalmstad(
+	const BenchContext& ctx, const HalmstadData& data, const std::vector<std::string>& sites, size_t negatives_per_map);
+
+}  // namespace multires_bench
