@@ -164,9 +164,18 @@ int mergeFleet(
 	if (!json.empty()) writeText(json, fleetJson(r, in.names, 0, clock.Tac()));
 	return r.allPlaced() ? kMerged : kNotMerged;
 }
-}  // namespace
+/** What the command line asks for. */
+struct Request
+{
+	std::vector<std::string> maps, topics;
+	std::string bag, json, out, png, config, write_config, output_resolution;
+	double simplemap_resolution = 0.05;
+	bool parameters = false, use_resolution_metadata = false, verbose = false;
+};
 
-int main(int argc, char** argv)
+/** Parses the command line (throws TCLAP's exceptions, and UsageError for
+ * what TCLAP lets through). */
+Request parseCommandLine(int argc, char** argv)
 {
 	TCLAP::CmdLine cmd(
 		"Merge two occupancy grid maps of possibly different resolution. The transform printed "
@@ -205,123 +214,144 @@ int main(int argc, char** argv)
 		"", "simplemap-resolution", "cell size for rendering .simplemap inputs", false, 0.05, "METRES", cmd);
 	TCLAP::SwitchArg verbose_arg("v", "verbose", "log each stage and hypothesis", cmd);
 
+	cmd.setExceptionHandling(false);
+	auto args = expandTopics(argc, argv);
+	cmd.parse(args);
+	for (const auto& m : maps_arg.getValue())  // TCLAP takes unknown flags as positionals
+		if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
+	// "--json --png x.png" wrote the JSON to a file named "--png".
+	for (const auto* a : {&json_arg, &out_arg, &png_arg, &config_arg, &bag_arg, &write_config_arg})
+		if (a->isSet() && !isFileName(a->getValue()))
+			throw UsageError("--" + a->getName() + " needs a file name, not '" + a->getValue() + "'");
+	Request q;
+	q.maps = maps_arg.getValue(), q.topics = topics_arg.getValue();
+	q.bag = bag_arg.getValue(), q.json = json_arg.getValue(), q.out = out_arg.getValue(), q.png = png_arg.getValue();
+	q.config = config_arg.getValue(), q.write_config = write_config_arg.getValue();
+	q.output_resolution = outres_arg.getValue();
+	q.simplemap_resolution = smres_arg.getValue();
+	q.parameters = parameters_arg.getValue(), q.use_resolution_metadata = metadata_arg.getValue();
+	q.verbose = verbose_arg.getValue();
+	return q;
+}
+
+/** Usage errors and outputs that cannot be written, found before any map is
+ * loaded (maps are not needed with --write-config). */
+void checkRequest(const Request& q)
+{
+	const bool bag_mode = !q.bag.empty();
+	if (!q.write_config.empty() && (bag_mode || !q.maps.empty()))
+		throw UsageError("--write-config takes no maps: it writes the parameters and exits");
+	if (bag_mode && !q.maps.empty()) throw UsageError("give either --bag FILE --topics A B or map files, not both");
+	if (!bag_mode && q.write_config.empty() && q.maps.size() < 2)
+		throw UsageError("give two or more map files (REF OTHER [OTHER ...]), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
+	if (!bag_mode && !q.topics.empty()) throw UsageError("--topics needs --bag");
+	if (bag_mode && q.topics.size() < 2)
+		throw UsageError("--bag needs --topics REF_TOPIC OTHER_TOPIC [OTHER_TOPIC ...] (two or more topics)");
+	if (!q.config.empty() && !std::filesystem::is_regular_file(q.config))
+		throw UsageError("'" + q.config + "': no such config file");
+	if (!std::isfinite(q.simplemap_resolution) || !(q.simplemap_resolution > 0))
+		throw UsageError("--simplemap-resolution must be metres > 0");
+	if (!q.out.empty() && !hasSuffix(q.out, ".gridmap.gz") && !hasSuffix(q.out, ".gridmap") && !hasSuffix(q.out, ".yaml"))
+		throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
+	for (const auto& [option, path] : {std::pair<std::string, std::string>{"json", q.json}, {"out", q.out}, {"png", q.png}})
+		if (!path.empty()) checkWritable(option, path);
+	if (hasSuffix(q.out, ".yaml"))  // and its image beside it
+		checkWritable("out", std::filesystem::path(q.out).replace_extension(".pgm").string());
+	if (!q.write_config.empty()) checkWritable("write-config", q.write_config);
+}
+
+/** Two maps: aligned, and if merged the merged map and overlay written.
+ * `r` holds the result for the JSON. */
+int mergePair(
+	const Inputs& in, const CScalingGridMapAligner& aligner, const Request& q, mrpt::system::CTicTac& clock,
+	CScalingGridMapAligner::TReturnInfo& r)
+{
+	const std::string &ref_name = in.names[0], &other_name = in.names[1];
+	const auto& ref = in.maps[0].grid;
+	const auto& other = in.maps[1].grid;
+	std::cout << "REF   " << ref_name << ": " << ref.getSizeX() << "x" << ref.getSizeY()
+			  << " cells, stated " << ref.getResolution() << " m\n"
+			  << "OTHER " << other_name << ": " << other.getSizeX() << "x" << other.getSizeY()
+			  << " cells, stated " << other.getResolution() << " m\n";
+
+	// Between the maps' frames, exact for any origin.
+	r = aligner.alignScaled(in.maps[0], in.maps[1]);
+	double res = 0;
+	if (r.success) res = outputResolution(q.output_resolution, ref.getResolution(), r.implied_resolution_other);
+	if (!r.success)
+	{
+		std::cout << "NOT MERGED: " << r.message << "\n";
+		if (!q.json.empty()) writeText(q.json, toJson(r, clock.Tac()));
+		return kNotMerged;
+	}
+	std::cout << "merged (confidence " << r.confidence << ", overlap " << r.overlap << ")\n"
+			  << "  OTHER's frame in REF's: x " << r.metric.t.x() << " m, y " << r.metric.t.y()
+			  << " m, yaw " << r.metric.yaw * 180 / M_PI << " deg, scale " << r.metric.scale << "\n"
+			  << "  cells: " << r.cells.scale << " REF cells per OTHER cell; OTHER's implied resolution "
+			  << r.implied_resolution_other << " m (stated " << other.getResolution() << " m)\n";
+
+	if (!q.out.empty() || !q.png.empty())
+	{
+		const FusedMap fused = fuseGridMaps(in.maps[0], in.maps[1], r.metric, res);
+		std::cout << "  merged map: " << fused.merged.grid.getSizeX() << "x" << fused.merged.grid.getSizeY()
+				  << " cells at " << fused.merged.grid.getResolution() << " m\n";
+		if (!q.out.empty())
+		{
+			const std::string note = saveGridMap(fused.merged, q.out);
+			std::cout << "  wrote " << q.out << "\n";
+			if (!note.empty()) std::cerr << "gridmap-merge: note: " << note << "\n";
+		}
+		if (!q.png.empty())
+		{
+			if (!cv::imwrite(q.png, overlayImage(fused.ref_classes, fused.other_classes)))
+				throw MapIOError("'" + q.png + "': cannot write PNG");
+			std::cout << "  wrote " << q.png << "\n";
+		}
+	}
+	if (!q.json.empty()) writeText(q.json, toJson(r, clock.Tac()));
+	return kMerged;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
 	CScalingGridMapAligner::TReturnInfo r;
 	mrpt::system::CTicTac clock;
+	std::string json;  // written on failure too, once known to be a file name
 	try
 	{
-		cmd.setExceptionHandling(false);
-		auto args = expandTopics(argc, argv);
-		cmd.parse(args);
-		for (const auto& m : maps_arg.getValue())  // TCLAP takes unknown flags as positionals
-			if (m.size() > 1 && m[0] == '-') throw UsageError("unknown option '" + m + "'; run with --help");
-		// "--json --png x.png" wrote the JSON to a file named "--png".
-		for (const auto* a : {&json_arg, &out_arg, &png_arg, &config_arg, &bag_arg, &write_config_arg})
-			if (a->isSet() && !isFileName(a->getValue()))
-				throw UsageError("--" + a->getName() + " needs a file name, not '" + a->getValue() + "'");
-		if (parameters_arg.getValue())
+		const Request q = parseCommandLine(argc, argv);
+		json = q.json;
+		if (q.parameters)
 		{
 			std::cout << alignerParamsMarkdown();
 			return kMerged;
 		}
-		const bool bag_mode = bag_arg.isSet();
-		if (write_config_arg.isSet() && (bag_mode || !maps_arg.getValue().empty()))
-			throw UsageError("--write-config takes no maps: it writes the parameters and exits");
-		if (bag_mode && !maps_arg.getValue().empty())
-			throw UsageError("give either --bag FILE --topics A B or map files, not both");
-		if (!bag_mode && !write_config_arg.isSet() && maps_arg.getValue().size() < 2)
-			throw UsageError("give two or more map files (REF OTHER [OTHER ...]), or --bag FILE --topics REF_TOPIC OTHER_TOPIC");
-		if (!bag_mode && topics_arg.isSet()) throw UsageError("--topics needs --bag");
-		if (bag_mode && topics_arg.getValue().size() < 2)
-			throw UsageError("--bag needs --topics REF_TOPIC OTHER_TOPIC [OTHER_TOPIC ...] (two or more topics)");
-
+		checkRequest(q);
 		CScalingGridMapAligner aligner;
-		if (config_arg.isSet())
+		if (!q.config.empty()) aligner.options.loadFromConfigFile(mrpt::config::CConfigFile(q.config), "aligner");
+		if (q.use_resolution_metadata) aligner.options.use_resolution_metadata = true;
+		if (q.verbose) aligner.setMinLoggingLevel(mrpt::system::LVL_DEBUG);
+		if (!q.write_config.empty())
 		{
-			if (!std::filesystem::is_regular_file(config_arg.getValue()))
-				throw UsageError("'" + config_arg.getValue() + "': no such config file");
-			aligner.options.loadFromConfigFile(mrpt::config::CConfigFile(config_arg.getValue()), "aligner");
-		}
-		if (metadata_arg.getValue()) aligner.options.use_resolution_metadata = true;
-		if (write_config_arg.isSet())
-		{
-			checkWritable(write_config_arg.getName(), write_config_arg.getValue());
-			mrpt::config::CConfigFile ini(write_config_arg.getValue());
+			mrpt::config::CConfigFile ini(q.write_config);
 			aligner.options.saveToConfigFile(ini, "aligner");
 			ini.writeNow();
-			std::cout << "wrote " << write_config_arg.getValue() << "\n";
+			std::cout << "wrote " << q.write_config << "\n";
 			return kMerged;
 		}
-		if (verbose_arg.getValue()) aligner.setMinLoggingLevel(mrpt::system::LVL_DEBUG);
-		if (!std::isfinite(smres_arg.getValue()) || !(smres_arg.getValue() > 0))
-			throw UsageError("--simplemap-resolution must be metres > 0");
-		if (out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".gridmap.gz") &&
-			!hasSuffix(out_arg.getValue(), ".gridmap") && !hasSuffix(out_arg.getValue(), ".yaml"))
-			throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
-		for (const auto* a : {&json_arg, &out_arg, &png_arg})
-			if (a->isSet()) checkWritable(a->getName(), a->getValue());
-		if (out_arg.isSet() && hasSuffix(out_arg.getValue(), ".yaml"))  // and its image beside it
-			checkWritable("out", std::filesystem::path(out_arg.getValue()).replace_extension(".pgm").string());
 
-		const Inputs in = bag_mode ? fromBag(bag_arg.getValue(), topics_arg.getValue())
-								   : fromFiles(maps_arg.getValue(), smres_arg.getValue());
-		const std::string& ref_name = in.names[0];
+		const Inputs in = q.bag.empty() ? fromFiles(q.maps, q.simplemap_resolution) : fromBag(q.bag, q.topics);
 		// A .gridmap holds no rotation: say so before any work.
-		if (in.maps[0].origin.yaw != 0 && out_arg.isSet() && !hasSuffix(out_arg.getValue(), ".yaml"))
+		if (in.maps[0].origin.yaw != 0 && !q.out.empty() && !hasSuffix(q.out, ".yaml"))
 			throw UsageError(
-				"--out: " + ref_name + " has a rotated origin, which only a .yaml map can hold; save as .yaml");
-		if (in.maps.size() > 2)
-		{
-			for (size_t m = 0; m < in.maps.size(); ++m)
-				std::cout << (m ? "OTHER " : "REF   ") << in.names[m] << ": " << in.maps[m].grid.getSizeX() << "x"
-						  << in.maps[m].grid.getSizeY() << " cells, stated " << in.maps[m].grid.getResolution()
-						  << " m\n";
-			return mergeFleet(in, aligner, outres_arg.getValue(), json_arg.getValue(), out_arg.getValue(),
-							  png_arg.getValue(), clock);
-		}
-		const std::string& other_name = in.names[1];
-		const auto& ref = in.maps[0].grid;
-		const auto& other = in.maps[1].grid;
-		std::cout << "REF   " << ref_name << ": " << ref.getSizeX() << "x" << ref.getSizeY()
-				  << " cells, stated " << ref.getResolution() << " m\n"
-				  << "OTHER " << other_name << ": " << other.getSizeX() << "x" << other.getSizeY()
-				  << " cells, stated " << other.getResolution() << " m\n";
-
-		// Between the maps' frames, exact for any origin.
-		r = aligner.alignScaled(in.maps[0], in.maps[1]);
-		double res = 0;
-		if (r.success) res = outputResolution(outres_arg.getValue(), ref.getResolution(), r.implied_resolution_other);
-		if (!r.success)
-		{
-			std::cout << "NOT MERGED: " << r.message << "\n";
-			if (json_arg.isSet()) writeText(json_arg.getValue(), toJson(r, clock.Tac()));
-			return kNotMerged;
-		}
-		std::cout << "merged (confidence " << r.confidence << ", overlap " << r.overlap << ")\n"
-				  << "  OTHER's frame in REF's: x " << r.metric.t.x() << " m, y " << r.metric.t.y()
-				  << " m, yaw " << r.metric.yaw * 180 / M_PI << " deg, scale " << r.metric.scale << "\n"
-				  << "  cells: " << r.cells.scale << " REF cells per OTHER cell; OTHER's implied resolution "
-				  << r.implied_resolution_other << " m (stated " << other.getResolution() << " m)\n";
-
-		if (out_arg.isSet() || png_arg.isSet())
-		{
-			const FusedMap fused = fuseGridMaps(in.maps[0], in.maps[1], r.metric, res);
-			std::cout << "  merged map: " << fused.merged.grid.getSizeX() << "x" << fused.merged.grid.getSizeY()
-					  << " cells at " << fused.merged.grid.getResolution() << " m\n";
-			if (out_arg.isSet())
-			{
-				const std::string note = saveGridMap(fused.merged, out_arg.getValue());
-				std::cout << "  wrote " << out_arg.getValue() << "\n";
-				if (!note.empty()) std::cerr << "gridmap-merge: note: " << note << "\n";
-			}
-			if (png_arg.isSet())
-			{
-				if (!cv::imwrite(png_arg.getValue(), overlayImage(fused.ref_classes, fused.other_classes)))
-					throw MapIOError("'" + png_arg.getValue() + "': cannot write PNG");
-				std::cout << "  wrote " << png_arg.getValue() << "\n";
-			}
-		}
-		if (json_arg.isSet()) writeText(json_arg.getValue(), toJson(r, clock.Tac()));
-		return kMerged;
+				"--out: " + in.names[0] + " has a rotated origin, which only a .yaml map can hold; save as .yaml");
+		if (in.maps.size() == 2) return mergePair(in, aligner, q, clock, r);
+		for (size_t m = 0; m < in.maps.size(); ++m)
+			std::cout << (m ? "OTHER " : "REF   ") << in.names[m] << ": " << in.maps[m].grid.getSizeX() << "x"
+					  << in.maps[m].grid.getSizeY() << " cells, stated " << in.maps[m].grid.getResolution() << " m\n";
+		return mergeFleet(in, aligner, q.output_resolution, q.json, q.out, q.png, clock);
 	}
 	catch (const TCLAP::ArgException& e)
 	{
@@ -337,11 +367,11 @@ int main(int argc, char** argv)
 		std::cerr << "gridmap-merge: " << e.what() << "\n";
 		r.success = false;
 		r.message = e.what();
-		if (json_arg.isSet() && isFileName(json_arg.getValue()))
+		if (isFileName(json))
 		{
 			try
 			{
-				writeText(json_arg.getValue(), toJson(r, clock.Tac()));
+				writeText(json, toJson(r, clock.Tac()));
 			}
 			catch (const std::exception&)
 			{

@@ -164,127 +164,144 @@ int largestGroupMember(size_t n, const std::vector<FleetEdge>& edges)
 }
 }  // namespace
 
-void LiveFleet::estimate()
+void LiveFleet::placeAtKnownPoses()
 {
-	// Snapshot under the lock; align without it (maps keep arriving).
-	const auto started = std::chrono::steady_clock::now();
-	std::vector<std::string> names;
-	std::vector<GridInFrame> maps;
-	std::vector<size_t> robot_of, versions, known_cells;  // per map in the snapshot
-	std::vector<bool> pending;  // a disagreeing estimate awaits confirmation
-	size_t world = 0, estimation = 0;
+	++version_;
+	for (auto& r : robots_)
 	{
-		std::lock_guard<std::mutex> lock(mutex_);
-		estimation = ++estimations_;
-		if (params_.known_init_poses)
-		{
-			++version_;
-			for (auto& r : robots_)
-			{
-				r.placed = r.map && r.init_pose;
-				if (r.placed) r.in_world = *r.init_pose, r.confidence = 1, r.message = "placed at its known initial pose";
-				else if (r.map) r.message = "no initial pose (map_merge/init_pose_x, _y, _z, _yaw in its namespace)";
-			}
-			return;
-		}
-		if (world_robot_.empty()) return;
-		for (size_t i = 0; i < robots_.size(); ++i)
-			if (Robot& r = robots_[i]; r.map)
-			{
-				if (r.name == world_robot_) world = names.size();
-				names.push_back(r.name);
-				maps.push_back(converted(r));
-				robot_of.push_back(i);
-				versions.push_back(r.map_version);
-				pending.push_back(r.pending.has_value());
-				known_cells.push_back(r.known_cells);
-			}
+		r.placed = r.map && r.init_pose;
+		if (r.placed) r.in_world = *r.init_pose, r.confidence = 1, r.message = "placed at its known initial pose";
+		else if (r.map) r.message = "no initial pose (map_merge/init_pose_x, _y, _z, _yaw in its namespace)";
 	}
-	// What the last estimations found and still holds (LiveFleetParams).
+}
+
+std::optional<LiveFleet::Snapshot> LiveFleet::takeSnapshot()
+{
+	if (world_robot_.empty()) return std::nullopt;
+	Snapshot s;
+	s.estimation = estimations_;
+	for (size_t i = 0; i < robots_.size(); ++i)
+		if (Robot& r = robots_[i]; r.map)
+		{
+			if (r.name == world_robot_) s.world = s.names.size();
+			s.names.push_back(r.name);
+			s.maps.push_back(converted(r));
+			s.robot_of.push_back(i);
+			s.versions.push_back(r.map_version);
+			s.pending.push_back(r.pending.has_value());
+			s.known_cells.push_back(r.known_cells);
+		}
+	return s;
+}
+
+FleetHints LiveFleet::hintsFor(const Snapshot& s, std::chrono::steady_clock::time_point started)
+{
 	FleetHints hints;
-	for (size_t m = 0; m < maps.size(); ++m)
+	for (size_t m = 0; m < s.maps.size(); ++m)
 	{
-		const auto it = prepared_memory_.find(robot_of[m]);
-		const bool current = it != prepared_memory_.end() && it->second.map_version == versions[m];
+		const auto it = prepared_memory_.find(s.robot_of[m]);
+		const bool current = it != prepared_memory_.end() && it->second.map_version == s.versions[m];
 		hints.prepared.push_back(current ? it->second.prepared : nullptr);
 		if (!current && it != prepared_memory_.end()) prepared_memory_.erase(it);  // not two of a map at once
 	}
-	auto index_of = [&](size_t robot) {
-		return size_t(std::find(robot_of.begin(), robot_of.end(), robot) - robot_of.begin());
-	};
-	hints.known = [&](size_t a, size_t b) -> std::optional<FleetHints::Known> {
-		const auto it = pair_memory_.find(std::minmax(robot_of[a], robot_of[b]));
+	hints.known = [this, &s](size_t a, size_t b) -> std::optional<FleetHints::Known> {
+		const auto it = pair_memory_.find(std::minmax(s.robot_of[a], s.robot_of[b]));
 		if (it == pair_memory_.end()) return std::nullopt;
 		const PairMemory& mem = it->second;
+		auto index_of = [&](size_t robot) {
+			return size_t(std::find(s.robot_of.begin(), s.robot_of.end(), robot) - s.robot_of.begin());
+		};
 		FleetHints::Known k;
 		k.edge = mem.edge;
 		k.edge.to = index_of(mem.edge.to), k.edge.from = index_of(mem.edge.from);
 		const size_t to = k.edge.to, from = k.edge.from;
-		const bool unchanged = versions[to] == mem.to_version && versions[from] == mem.from_version;
+		const bool unchanged = s.versions[to] == mem.to_version && s.versions[from] == mem.from_version;
 		auto grew = [&](size_t now, size_t then) { return double(now) > (1 + params_.retry_growth) * double(then); };
-		const bool worth_retrying = grew(known_cells[to], mem.to_known) || grew(known_cells[from], mem.from_known) ||
-			estimation >= mem.estimation + params_.retry_estimations;
+		const bool worth_retrying = grew(s.known_cells[to], mem.to_known) || grew(s.known_cells[from], mem.from_known) ||
+			s.estimation >= mem.estimation + params_.retry_estimations;
 		k.holds = unchanged || (!mem.edge.merged && !worth_retrying);
-		k.age = estimation - mem.estimation;
+		k.age = s.estimation - mem.estimation;
 		// Tracking follows the last result; a fresh search now and then, and
 		// whenever a move awaits confirmation, keeps a wrong placement from
 		// confirming itself.
-		k.track = !pending[to] && !pending[from] && estimation < mem.searched + params_.retry_estimations;
+		k.track = !s.pending[to] && !s.pending[from] && s.estimation < mem.searched + params_.retry_estimations;
 		return k;
 	};
 	hints.overdue_age = params_.retry_estimations;
 	if (params_.estimation_budget_s > 0)
 		hints.deadline = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
 									   std::chrono::duration<double>(params_.estimation_budget_s));
+	return hints;
+}
+
+void LiveFleet::remember(const Snapshot& s, const FleetResult& result)
+{
+	for (size_t m = 0; m < s.maps.size(); ++m)
+		if (result.prepared[m]->problem.rfind("could not be prepared", 0) != 0)  // a failure is tried again
+			prepared_memory_[s.robot_of[m]] = {s.versions[m], result.prepared[m]};
+	// Every fresh alignment, as the aligner gave it: one dropped around a
+	// cycle is dropped again while its maps stay as they are.
+	for (const FleetEdge& e : result.edges)
+	{
+		if (e.reused) continue;
+		const auto key = std::minmax(s.robot_of[e.to], s.robot_of[e.from]);
+		PairMemory mem;
+		mem.edge = e;
+		mem.edge.dropped = false;
+		mem.edge.to = s.robot_of[e.to], mem.edge.from = s.robot_of[e.from];
+		mem.to_version = s.versions[e.to], mem.from_version = s.versions[e.from];
+		mem.to_known = s.known_cells[e.to], mem.from_known = s.known_cells[e.from];
+		mem.estimation = s.estimation;
+		const auto before = pair_memory_.find(key);
+		mem.searched = e.tracked && before != pair_memory_.end() ? before->second.searched : s.estimation;
+		pair_memory_[key] = mem;
+	}
+}
+
+bool LiveFleet::moveWorldIfAlone(const Snapshot& s, size_t& world, FleetResult& result) const
+{
+	const bool alone = std::none_of(result.maps.begin(), result.maps.end(), [&](const FleetPlacement& p) {
+		return p.placed && &p != &result.maps[world];
+	});
+	if (!alone || worldCommitted()) return false;
+	const int better = largestGroupMember(s.maps.size(), result.edges);
+	if (better < 0 || size_t(better) == world) return false;
+	world = size_t(better);
+	result = placeFromPairs(s.maps, world, result.edges);  // on the pairs aligned so far
+	return true;
+}
+
+void LiveFleet::estimate()
+{
+	// Snapshot under the lock; align without it (maps keep arriving).
+	const auto started = std::chrono::steady_clock::now();
+	std::optional<Snapshot> snapshot;
+	{
+		std::lock_guard<std::mutex> lock(mutex_);
+		++estimations_;
+		if (params_.known_init_poses) return placeAtKnownPoses();
+		if (!(snapshot = takeSnapshot())) return;
+	}
+	const Snapshot& s = *snapshot;
+	size_t world = s.world;
 	std::optional<FleetResult> result;
 	std::string failure;
 	bool world_moved = false;
 	EstimationStats stats;
-	stats.maps = maps.size();
-	if (maps.size() >= 2)
+	stats.maps = s.maps.size();
+	if (s.maps.size() >= 2)
 	{
 		try
 		{
+			const FleetHints hints = hintsFor(s, started);
 			CScalingGridMapAligner aligner;
 			aligner.options = params_.aligner;
-			result = placeFleet(maps, world, aligner, {}, hints);
+			result = placeFleet(s.maps, world, aligner, {}, hints);
 			stats.pairs_aligned = result->pairs_aligned, stats.pairs_reused = result->pairs_reused;
 			stats.pairs_deferred = result->pairs_deferred, stats.pairs_skipped = result->pairs_skipped;
 			stats.maps_prepared = size_t(std::count(hints.prepared.begin(), hints.prepared.end(), nullptr));
-			for (size_t m = 0; m < maps.size(); ++m)
-				if (result->prepared[m]->problem.rfind("could not be prepared", 0) != 0)  // a failure is tried again
-					prepared_memory_[robot_of[m]] = {versions[m], result->prepared[m]};
-			// Every fresh alignment, as the aligner gave it: one dropped around a
-			// cycle is dropped again while its maps stay as they are.
-			for (const FleetEdge& e : result->edges)
-			{
-				if (e.reused) continue;
-				const auto key = std::minmax(robot_of[e.to], robot_of[e.from]);
-				PairMemory mem;
-				mem.edge = e;
-				mem.edge.dropped = false;
-				mem.edge.to = robot_of[e.to], mem.edge.from = robot_of[e.from];
-				mem.to_version = versions[e.to], mem.from_version = versions[e.from];
-				mem.to_known = known_cells[e.to], mem.from_known = known_cells[e.from];
-				mem.estimation = estimation;
-				const auto before = pair_memory_.find(key);
-				mem.searched = e.tracked && before != pair_memory_.end() ? before->second.searched : estimation;
-				pair_memory_[key] = mem;
-			}
-			// The world is provisional until a second robot is placed in it: if
-			// its robot overlaps no one (another building, a robot far away)
-			// while others overlap each other, the world moves to the largest
-			// group, on the pairs aligned so far.
-			const bool alone = std::none_of(result->maps.begin(), result->maps.end(), [&](const FleetPlacement& p) {
-				return p.placed && &p != &result->maps[world];
-			});
-			if (alone && !worldCommitted())
-				if (const int better = largestGroupMember(maps.size(), result->edges); better >= 0 && size_t(better) != world)
-				{
-					world = size_t(better);
-					result = placeFromPairs(maps, world, result->edges);
-					world_moved = true;
-				}
+			remember(s, *result);
+			world_moved = moveWorldIfAlone(s, world, *result);
 		}
 		catch (const std::exception& e)
 		{
@@ -297,12 +314,18 @@ void LiveFleet::estimate()
 	++version_;  // placements may have changed
 	if (world_moved)
 	{
-		world_robot_ = names[world];
+		world_robot_ = s.names[world];
 		for (auto& r : robots_) r.placed = false, r.pending.reset();  // nobody else was placed yet
 	}
-	for (size_t i = 0; i < names.size(); ++i)
+	applyEstimate(s, world, result, failure);
+}
+
+void LiveFleet::applyEstimate(
+	const Snapshot& s, size_t world, const std::optional<FleetResult>& result, const std::string& failure)
+{
+	for (size_t i = 0; i < s.names.size(); ++i)
 	{
-		Robot& r = *find(names[i]);
+		Robot& r = *find(s.names[i]);
 		if (i == world)
 		{
 			r.placed = true, r.in_world = Similarity2D(), r.confidence = 1, r.message = "the world frame is its map frame";
@@ -319,13 +342,13 @@ void LiveFleet::estimate()
 			r.message = r.placed ? "kept its last placement; latest estimate: " + p.message : p.message;
 			continue;
 		}
-		const std::string through = p.parent >= 0 && size_t(p.parent) != world ? " through " + names[p.parent] : "";
-		if (!r.placed || agree(maps[i], r.in_world, p.in_reference))
+		const std::string through = p.parent >= 0 && size_t(p.parent) != world ? " through " + s.names[p.parent] : "";
+		if (!r.placed || agree(s.maps[i], r.in_world, p.in_reference))
 		{
 			r.message = (r.placed ? "placement refined" : "placed") + through;
 			r.placed = true, r.in_world = p.in_reference, r.confidence = p.confidence, r.pending.reset();
 		}
-		else if (r.pending && agree(maps[i], *r.pending, p.in_reference))
+		else if (r.pending && agree(s.maps[i], *r.pending, p.in_reference))
 		{
 			r.message = "moved to a new placement confirmed twice" + through;
 			r.in_world = p.in_reference, r.confidence = p.confidence, r.pending.reset();

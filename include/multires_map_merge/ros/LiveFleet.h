@@ -18,6 +18,7 @@
 #include <map_msgs/OccupancyGridUpdate.h>
 #include <nav_msgs/OccupancyGrid.h>
 
+#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -145,6 +146,34 @@ class LiveFleet
 		size_t map_version = 0;
 		CScalingGridMapAligner::PreparedMapPtr prepared;
 	};
+	/** What one estimation works on: every robot's map as it was when the
+	 * estimation started, taken under the lock. Index m: the m-th robot with
+	 * a map. */
+	struct Snapshot
+	{
+		std::vector<std::string> names;
+		std::vector<GridInFrame> maps;
+		std::vector<size_t> robot_of, versions, known_cells;  //!< robot index into robots_, its map's version, known cells
+		std::vector<bool> pending;  //!< a disagreeing estimate awaits confirmation
+		size_t world = 0, estimation = 0;
+	};
+	/** The estimation's inputs (lock held); nothing without a world robot. */
+	std::optional<Snapshot> takeSnapshot();
+	/** With known_init_poses: every robot with a map at its pose (lock held). */
+	void placeAtKnownPoses();
+	/** What earlier estimations found and still holds, for placeFleet
+	 * (LiveFleetParams); `snapshot` must outlive the hints. */
+	FleetHints hintsFor(const Snapshot& snapshot, std::chrono::steady_clock::time_point started);
+	/** Keeps the prepared maps and every fresh alignment for later estimations. */
+	void remember(const Snapshot& snapshot, const FleetResult& result);
+	/** The world is provisional until a second robot is placed in it: if its
+	 * robot overlaps no one while others overlap each other, it moves to the
+	 * largest group. Returns whether it moved (`world`, `result` then updated). */
+	bool moveWorldIfAlone(const Snapshot& snapshot, size_t& world, FleetResult& result) const;
+	/** Each robot's new state from the estimate, by the confirmation rule
+	 * (lock held). */
+	void applyEstimate(
+		const Snapshot& snapshot, size_t world, const std::optional<FleetResult>& result, const std::string& failure);
 	/** `r`'s map as a grid, converted if it changed since (lock held). */
 	const GridInFrame& converted(Robot& r);
 	Robot* find(const std::string& name);
