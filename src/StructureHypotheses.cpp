@@ -68,6 +68,218 @@ double dominantWallDirection(const cv::Mat& classes)
 
 namespace
 {
+/** The reference's walls at the sizes the poses need (the other map is
+ * never enlarged: the reference shrinks instead), each within its bounding
+ * box (the rest of a map is often unexplored margin: the correlation is the
+ * same, its DFTs smaller), with their spectra per canvas. Shared by the
+ * pose threads: made outside the lock (the threads would wait on each
+ * other), the first one made kept. */
+class RefViews
+{
+   public:
+	struct View
+	{
+		double f = 0;  //!< ref full cells → this image
+		cv::Mat walls;  //!< within their bounding box ...
+		cv::Point corner;  //!< ... whose corner this is in the whole image
+		bool has_walls = false;  //!< any wall left at this size
+	};
+
+	RefViews(const cv::Mat& ref_occupied, double f_ref, const cv::Mat& walls_at_f_ref) : ref_occupied_(ref_occupied)
+	{
+		views_.emplace(f_ref, Entry{makeView(f_ref, walls_at_f_ref), {}});
+	}
+
+	const View& at(double f)
+	{
+		{
+			std::lock_guard<std::mutex> lock(mutex_);
+			if (auto it = views_.find(f); it != views_.end()) return it->second.view;
+		}
+		View made = makeView(f, wallImage(ref_occupied_, f));
+		std::lock_guard<std::mutex> lock(mutex_);
+		return views_.emplace(f, Entry{std::move(made), {}}).first->second.view;
+	}
+
+	/** The view's walls (squared 0) or walls² (1) on `canvas`, packed (CCS). */
+	cv::Mat spectrum(const View& v, int squared, cv::Size canvas)
+	{
+		const std::tuple key{squared, canvas.width, canvas.height};
+		{
+			std::lock_guard<std::mutex> lock(mutex_);
+			const auto& spectra = views_.at(v.f).spectra;
+			if (auto it = spectra.find(key); it != spectra.end()) return it->second;
+		}
+		cv::Mat made = packedSpectrum(squared ? v.walls.mul(v.walls) : v.walls, canvas);
+		std::lock_guard<std::mutex> lock(mutex_);
+		return views_.at(v.f).spectra.emplace(key, std::move(made)).first->second;
+	}
+
+	/** A real image's spectrum on `canvas`, packed (CCS): half the work of a complex one. */
+	static cv::Mat packedSpectrum(const cv::Mat& img, cv::Size canvas)
+	{
+		cv::Mat pad = cv::Mat::zeros(canvas, CV_32F), f;
+		img.copyTo(pad(cv::Rect(0, 0, img.cols, img.rows)));
+		cv::dft(pad, f, 0, img.rows);
+		return f;
+	}
+
+   private:
+	struct Entry
+	{
+		View view;
+		std::map<std::tuple<int, int, int>, cv::Mat> spectra;
+	};
+	static View makeView(double f, const cv::Mat& whole)
+	{
+		View v;
+		v.f = f;
+		const cv::Rect box = cv::boundingRect(whole > 0);
+		v.has_walls = !box.empty();
+		v.walls = v.has_walls ? whole(box) : whole;
+		v.corner = box.tl();
+		return v;
+	}
+
+	const cv::Mat& ref_occupied_;
+	std::map<double, Entry> views_;  // by factor
+	std::mutex mutex_;
+};
+
+/** The box `lin` maps an image of `size` onto. */
+std::pair<Eigen::Vector2d, Eigen::Vector2d> placedBox(const Similarity2D& lin, cv::Size size)
+{
+	Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
+	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(size.width, 0),
+									 Eigen::Vector2d(0, size.height), Eigen::Vector2d(size.width, size.height)})
+		lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
+	return {lo, hi};
+}
+
+/** Shifts past the middle of the canvas are negative: the FFT wraps. */
+int signedShift(int i, int canvas, int img) { return i > canvas - img ? i - canvas : i; }
+
+/** C(i) = Σ walls(x)·img(x − i) (walls² with `squared`) for every shift i
+ * on a canvas that holds both. */
+cv::Mat correlate(RefViews& views, const RefViews::View& view, int squared, const cv::Mat& img)
+{
+	const cv::Size canvas(
+		cv::getOptimalDFTSize(view.walls.cols + img.cols), cv::getOptimalDFTSize(view.walls.rows + img.rows));
+	cv::Mat prod, c;
+	cv::mulSpectrums(views.spectrum(view, squared, canvas), RefViews::packedSpectrum(img, canvas), prod, 0, true);
+	cv::dft(prod, c, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
+	return c;
+}
+
+/** The other map's walls placed by one pose (scale × right-angle turn), up to a translation. */
+struct PlacedOther
+{
+	Similarity2D place;  //!< other's working image → this image
+	cv::Mat walls, footprint;  //!< the warped walls, and where the other map lies at all
+	double energy = 0;  //!< Σ walls²
+};
+
+/** The masked normalised cross-correlation of the placed other map with the
+ * reference's walls: Σ a·b over the energy of both where they overlap, so a
+ * shrunken, dense copy of the other map cannot win by touching many walls.
+ * Two correlations on two canvases: the walls' needs only the other map's
+ * walls (their bounding box, `walls_box`), the energy's the whole footprint.
+ * Index i of the result is the other map placed at i − the walls' corner. */
+cv::Mat normalisedCorrelation(
+	RefViews& views, const RefViews::View& view, const PlacedOther& other, const cv::Rect& walls_box)
+{
+	const cv::Mat other_walls = other.walls(walls_box);
+	cv::Mat corr = correlate(views, view, 0, other_walls);
+	const cv::Mat a_energy = correlate(views, view, 1, other.footprint);
+	std::vector<int> energy_col(corr.cols);
+	for (int i = 0; i < corr.cols; ++i)
+		energy_col[i] = (signedShift(i, corr.cols, other_walls.cols) - walls_box.x + a_energy.cols) % a_energy.cols;
+	for (int r = 0; r < corr.rows; ++r)
+	{
+		const int er = (signedShift(r, corr.rows, other_walls.rows) - walls_box.y + a_energy.rows) % a_energy.rows;
+		const float* e = a_energy.ptr<float>(er);
+		float* c = corr.ptr<float>(r);
+		for (int i = 0; i < corr.cols; ++i)
+			c[i] /= float(std::sqrt(std::max(double(e[energy_col[i]]), 1e-3 * other.energy) * other.energy));
+	}
+	return corr;
+}
+
+/** The `peaks` highest correlations, each as the other map's working image
+ * placed in the view's (a peak's neighbours, on the wrapped shifts too,
+ * cleared before the next: the canvas's seam runs between shifts 0 and -1). */
+std::vector<std::pair<Similarity2D, double>> takePeaks(
+	cv::Mat corr, const RefViews::View& view, const PlacedOther& other, const cv::Rect& walls_box, int peaks)
+{
+	std::vector<std::pair<Similarity2D, double>> out;
+	for (int peak = 0; peak < peaks; ++peak)
+	{
+		double best;
+		cv::Point at;
+		cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
+		if (!(best > 0)) break;
+		const double dx = signedShift(at.x, corr.cols, walls_box.width) - walls_box.x,
+					 dy = signedShift(at.y, corr.rows, walls_box.height) - walls_box.y;
+		out.emplace_back(
+			Similarity2D(other.place.scale, other.place.yaw,
+						 other.place.t + Eigen::Vector2d(dx + view.corner.x, dy + view.corner.y)),
+			best);
+		for (int ox : {-corr.cols, 0, corr.cols})
+			for (int oy : {-corr.rows, 0, corr.rows})
+				cv::circle(corr, at + cv::Point(ox, oy), 6, cv::Scalar(0), cv::FILLED);
+	}
+	return out;
+}
+
+/** What every pose of one search shares. */
+struct PoseSearch
+{
+	const cv::Mat& other_walls;  //!< the other map's walls at its working size
+	double f_ref, f_other;
+	int working_size, peaks;
+	RefViews& views;
+};
+
+/** One pose (scale `s`, turn `yaw`): the other map placed, correlated with
+ * the reference's walls at the size that keeps it unenlarged, its peaks as
+ * other's full cells → ref's full cells. Nothing if the pose does not fit. */
+std::vector<Scored> searchPose(const PoseSearch& ps, double s, double yaw)
+{
+	const cv::Mat& b0 = ps.other_walls;
+	{
+		// The poses searched: those whose other map fits three working sizes
+		// at the reference's working size (as before the shrink).
+		const auto [lo, hi] = placedBox(Similarity2D(s * ps.f_ref / ps.f_other, yaw, {0, 0}), b0.size());
+		if (hi.x() - lo.x() + 1 > 3 * ps.working_size || hi.y() - lo.y() + 1 > 3 * ps.working_size) return {};
+	}
+	// Where the other map would be enlarged (scale above one), the reference
+	// is shrunk instead: the canvas, and with it the DFTs, stay about twice
+	// the working size instead of growing with the scale, at the same
+	// resolution of the other map's cells.
+	const double f_view = ps.f_ref * std::min(1.0, ps.f_other / (s * ps.f_ref));
+	const Similarity2D lin(s * f_view / ps.f_other, yaw, {0, 0});
+	const auto [lo, hi] = placedBox(lin, b0.size());
+	const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
+	if (bw < 8 || bh < 8) return {};
+	PlacedOther other;
+	other.place = Similarity2D(lin.scale, lin.yaw, -lo);  // into a bw × bh image
+	const Eigen::Matrix2d l = other.place.linear();
+	const cv::Mat m = (cv::Mat_<double>(2, 3) << l(0, 0), l(0, 1), other.place.t.x(), l(1, 0), l(1, 1), other.place.t.y());
+	cv::warpAffine(b0, other.walls, m, cv::Size(bw, bh), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+	other.energy = cv::sum(other.walls.mul(other.walls))[0];
+	if (other.energy <= 0) return {};
+	const RefViews::View& view = ps.views.at(f_view);
+	if (!view.has_walls) return {};
+	cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), other.footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
+	const cv::Rect walls_box = cv::boundingRect(other.walls > 0);
+	std::vector<Scored> found;
+	const Similarity2D other_down = resampling(ps.f_other);
+	for (const auto& [working, score] :
+		 takePeaks(normalisedCorrelation(ps.views, view, other, walls_box), view, other, walls_box, ps.peaks))
+		found.push_back({resampling(view.f).inverse().compose(working).compose(other_down), score});
+	return found;
+}
+
 /** The correlation peaks (`peaks` per pose; pose = scale index × 4 +
  * right-angle turn), with both maps at most `working_size` across; empty
  * where a pose was skipped. */
@@ -80,159 +292,13 @@ std::vector<std::vector<Scored>> searchPoses(
 	const double f_other = fitFactor(other_occupied, working_size);
 	const cv::Mat a = wallImage(ref_occupied, f_ref), b0 = wallImage(other_occupied, f_other);
 	if (cv::sum(a)[0] <= 0 || cv::sum(b0.mul(b0))[0] <= 0) return found_per_pose;
-	const Similarity2D other_down = resampling(f_other);
-	// Where the other map would be enlarged (scale above one), the reference
-	// is shrunk instead: the canvas, and with it the DFTs, stay about twice
-	// the working size instead of growing with the scale (most of the time
-	// went there), at the same resolution of the other map's cells.
-	// The reference's walls are kept only within their bounding box (the
-	// rest of a map is often unexplored margin): the correlation is the same,
-	// its DFTs smaller.
-	struct RefView
-	{
-		double f = 0;  //!< ref full cells → this image
-		cv::Mat walls;  //!< within their bounding box ...
-		cv::Point corner;  //!< ... whose corner this is in the whole image
-		bool has_walls = false;  //!< any wall left at this size
-		std::map<std::tuple<int, int, int>, cv::Mat> spectra;  //!< of walls (0) and walls² (1), by canvas size
-	};
-	auto makeView = [&](double f, const cv::Mat& whole) {
-		RefView v;
-		v.f = f;
-		const cv::Rect box = cv::boundingRect(whole > 0);
-		v.has_walls = !box.empty();
-		v.walls = v.has_walls ? whole(box) : whole;
-		v.corner = box.tl();
-		return v;
-	};
-	std::map<double, RefView> ref_views;  // by factor
-	ref_views.emplace(f_ref, makeView(f_ref, a));
-	std::mutex spectra_mutex;
-	// The poses (scale × right-angle turn) are independent: searched in
-	// parallel, each keeping its own peaks, gathered in pose order so the
-	// result does not depend on the threads.
+	RefViews views(ref_occupied, f_ref, a);
+	const PoseSearch ps{b0, f_ref, f_other, working_size, peaks, views};
+	// The poses are independent: searched in parallel, each keeping its own
+	// peaks, gathered in pose order so the result does not depend on the threads.
 	cv::parallel_for_(cv::Range(0, int(scales.size() * 4)), [&](const cv::Range& range) {
 		for (int pose = range.start; pose < range.end; ++pose)
-		{
-			const double s = scales[pose / 4];
-			const int k = pose % 4;
-			std::vector<Scored>& found = found_per_pose[pose];
-			// Other's working image → ref's working image, up to a translation.
-			auto placedSize = [&](const Similarity2D& lin) {
-				Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
-				for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b0.cols, 0),
-												 Eigen::Vector2d(0, b0.rows), Eigen::Vector2d(b0.cols, b0.rows)})
-					lo = lo.cwiseMin(lin(c)), hi = hi.cwiseMax(lin(c));
-				return std::pair{lo, hi};
-			};
-			{
-				// The poses searched: those whose other map fits three working
-				// sizes at the reference's working size (as before the shrink).
-				const auto [lo, hi] = placedSize(Similarity2D(s * f_ref / f_other, turn + k * M_PI / 2, {0, 0}));
-				if (hi.x() - lo.x() + 1 > 3 * working_size || hi.y() - lo.y() + 1 > 3 * working_size) continue;
-			}
-			const double f_view = f_ref * std::min(1.0, f_other / (s * f_ref));
-			const Similarity2D lin(s * f_view / f_other, turn + k * M_PI / 2, {0, 0});
-			const auto [lo, hi] = placedSize(lin);
-			const int bw = static_cast<int>(std::ceil(hi.x() - lo.x())) + 1, bh = static_cast<int>(std::ceil(hi.y() - lo.y())) + 1;
-			if (bw < 8 || bh < 8) continue;
-			const Similarity2D place(lin.scale, lin.yaw, -lo);  // into a bw × bh image
-			const Eigen::Matrix2d l = place.linear();
-			const cv::Mat m = (cv::Mat_<double>(2, 3) << l(0, 0), l(0, 1), place.t.x(), l(1, 0), l(1, 1), place.t.y());
-			cv::Mat b;
-			cv::warpAffine(b0, b, m, cv::Size(bw, bh), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-			const double placed_energy = cv::sum(b.mul(b))[0];
-			if (placed_energy <= 0) continue;
-
-			// C(d) = Σ a(x)·b(x − d) for every shift at once, normalised by the
-			// energy of both where they overlap (masked normalised cross-
-			// correlation): a shrunken, dense copy of the other map must not
-			// win by touching many walls.
-			// Views and spectra are made outside the lock (the threads would
-			// wait on each other); the first one made is kept.
-			RefView* view = nullptr;
-			{
-				std::lock_guard<std::mutex> lock(spectra_mutex);
-				if (auto it = ref_views.find(f_view); it != ref_views.end()) view = &it->second;
-			}
-			if (!view)
-			{
-				RefView made = makeView(f_view, wallImage(ref_occupied, f_view));
-				std::lock_guard<std::mutex> lock(spectra_mutex);
-				view = &ref_views.emplace(f_view, std::move(made)).first->second;
-			}
-			const cv::Mat& a = view->walls;
-			if (!view->has_walls) continue;
-			// Two correlations on two canvases: the walls' needs only the other
-			// map's walls (their bounding box), the energy's the whole footprint.
-			const cv::Rect walls_box = cv::boundingRect(b > 0);
-			const cv::Mat other_walls = b(walls_box);
-			auto canvasFor = [&](const cv::Mat& img) {
-				return cv::Size(cv::getOptimalDFTSize(a.cols + img.cols), cv::getOptimalDFTSize(a.rows + img.rows));
-			};
-			// Real images: their spectra packed (CCS), half the work of complex ones.
-			auto spectrum = [](const cv::Mat& img, cv::Size canvas) {
-				cv::Mat pad = cv::Mat::zeros(canvas, CV_32F), f;
-				img.copyTo(pad(cv::Rect(0, 0, img.cols, img.rows)));
-				cv::dft(pad, f, 0, img.rows);
-				return f;
-			};
-			// The reference's spectra, walls (0) or walls² (1), kept per canvas.
-			auto refSpectrum = [&](int squared, cv::Size canvas) {
-				const std::tuple key{squared, canvas.width, canvas.height};
-				{
-					std::lock_guard<std::mutex> lock(spectra_mutex);
-					if (auto it = view->spectra.find(key); it != view->spectra.end()) return it->second;
-				}
-				cv::Mat made = spectrum(squared ? a.mul(a) : a, canvas);
-				std::lock_guard<std::mutex> lock(spectra_mutex);
-				return view->spectra.emplace(key, std::move(made)).first->second;
-			};
-			// C(i) = Σ a(x)·img(x − i) for every shift i on the canvas (shifts
-			// past the middle are negative: the FFT wraps).
-			auto correlate = [&](int squared, const cv::Mat& img) {
-				const cv::Size canvas = canvasFor(img);
-				cv::Mat prod, c;
-				cv::mulSpectrums(refSpectrum(squared, canvas), spectrum(img, canvas), prod, 0, true);
-				cv::dft(prod, c, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT | cv::DFT_SCALE);
-				return c;
-			};
-			auto signedShift = [](int i, int canvas, int img) { return i > canvas - img ? i - canvas : i; };
-			cv::Mat footprint;
-			cv::warpAffine(cv::Mat::ones(b0.size(), CV_32F), footprint, m, cv::Size(bw, bh), cv::INTER_NEAREST);
-			cv::Mat corr = correlate(0, other_walls);
-			const cv::Mat a_energy = correlate(1, footprint);
-			// corr at i is the other map placed at i − the walls' corner.
-			std::vector<int> energy_col(corr.cols);
-			for (int i = 0; i < corr.cols; ++i)
-				energy_col[i] = (signedShift(i, corr.cols, other_walls.cols) - walls_box.x + a_energy.cols) % a_energy.cols;
-			for (int r = 0; r < corr.rows; ++r)
-			{
-				const int er = (signedShift(r, corr.rows, other_walls.rows) - walls_box.y + a_energy.rows) % a_energy.rows;
-				const float* e = a_energy.ptr<float>(er);
-				float* c = corr.ptr<float>(r);
-				for (int i = 0; i < corr.cols; ++i)
-					c[i] /= float(std::sqrt(std::max(double(e[energy_col[i]]), 1e-3 * placed_energy) * placed_energy));
-			}
-			for (int peak = 0; peak < peaks; ++peak)
-			{
-				double best;
-				cv::Point at;
-				cv::minMaxLoc(corr, nullptr, &best, nullptr, &at);
-				if (!(best > 0)) break;
-				const double dx = signedShift(at.x, corr.cols, other_walls.cols) - walls_box.x,
-							 dy = signedShift(at.y, corr.rows, other_walls.rows) - walls_box.y;
-				const Similarity2D working(
-					place.scale, place.yaw,
-					place.t + Eigen::Vector2d(dx + view->corner.x, dy + view->corner.y));
-				found.push_back({resampling(view->f).inverse().compose(working).compose(other_down), best});
-				// The next peak not beside this one, on the wrapped shifts too
-				// (the canvas's seam runs between shifts 0 and -1).
-				for (int ox : {-corr.cols, 0, corr.cols})
-					for (int oy : {-corr.rows, 0, corr.rows})
-						cv::circle(corr, at + cv::Point(ox, oy), 6, cv::Scalar(0), cv::FILLED);
-			}
-		}
+			found_per_pose[pose] = searchPose(ps, scales[pose / 4], turn + (pose % 4) * M_PI / 2);
 	});
 	return found_per_pose;
 }
