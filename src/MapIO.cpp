@@ -8,6 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <unistd.h>  // access(): may this process write there
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,6 +23,18 @@
 namespace multires_map_merge
 {
 using mrpt::maps::COccupancyGridMap2D;
+
+std::string whyNotWritable(const std::string& path)
+{
+	namespace fs = std::filesystem;
+	const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
+	std::error_code ec;
+	if (!fs::is_directory(folder, ec)) return "no folder '" + folder.string() + "' to write into";
+	const bool exists = fs::exists(path, ec);
+	if (exists && !fs::is_regular_file(path, ec)) return "exists and is not a file";
+	const bool writable = exists ? ::access(path.c_str(), W_OK) == 0 : ::access(folder.c_str(), W_OK | X_OK) == 0;
+	return writable ? "" : "cannot write there (permission denied)";
+}
 
 bool hasSuffix(const std::string& s, const std::string& suffix)
 {

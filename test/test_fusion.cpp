@@ -179,6 +179,17 @@ TEST(MapIO, BadFilesGiveErrorsNamingTheFile)
 	expectError(tmp("noimage.yaml"), "unreadable");
 }
 
+// Programs ask before any work whether each output can be written.
+TEST(MapIO, WhyNotWritableNamesWhatIsInTheWay)
+{
+	EXPECT_EQ(whyNotWritable(tmp("new_output.yaml")), "");
+	std::ofstream(tmp("existing_output.json")) << "{}";
+	EXPECT_EQ(whyNotWritable(tmp("existing_output.json")), "");
+	EXPECT_NE(whyNotWritable(tmp("no_such_folder/out.yaml")).find("no folder"), std::string::npos);
+	std::filesystem::create_directories(tmp("a_folder"));
+	EXPECT_NE(whyNotWritable(tmp("a_folder")).find("exists and is not a file"), std::string::npos);
+}
+
 TEST(MapIO, ReadsTheRealWillowMapServerFiles)
 {
 	MMM_REQUIRE_SHARED(yaml, "ros_maps/willow/navstage_willow_10cm.yaml");

@@ -100,6 +100,21 @@ TEST(RosbagMerge, MissingBagOrTopicIsNamed)
 	}
 }
 
+// fleet-bag renders for seconds before it writes: an --out it cannot write
+// is refused first, naming it.
+TEST(RosbagMerge, FleetBagRefusesAnUnwritableOutputBeforeRendering)
+{
+	const std::string out = ::testing::TempDir() + "/no_such_folder/session.bag";
+	FILE* p = popen((std::string(MMM_FLEET_BAG) + " --out " + out + " 2>&1").c_str(), "r");
+	std::string text;
+	char buf[512];
+	while (p && fgets(buf, sizeof buf, p)) text += buf;
+	const int status = p ? pclose(p) : -1;
+	EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2) << text;
+	EXPECT_NE(text.find("--out '" + out + "': no folder"), std::string::npos) << text;
+	EXPECT_EQ(text.find("wrote"), std::string::npos) << text;
+}
+
 TEST(RosbagMerge, CliMergesTheLastMapsOnTwoTopics)
 {
 	const std::string dir = ::testing::TempDir() + "/bags";

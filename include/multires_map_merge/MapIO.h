@@ -40,4 +40,10 @@ std::string saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::
 
 bool hasSuffix(const std::string& s, const std::string& suffix);
 
+/** Why a file cannot be written at `path` ("" when it can): no folder to
+ * write into, a folder or other non-file in the way, or no permission.
+ * Nothing is created or truncated; programs ask before any work, so that
+ * an output that cannot be written is not found at the end. */
+std::string whyNotWritable(const std::string& path);
+
 }  // namespace multires_map_merge

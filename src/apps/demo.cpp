@@ -28,13 +28,15 @@ int main(int argc, char** argv)
 	{
 		if (argc == 3 && std::string(argv[1]) == "--write")
 		{
+			const std::string dir = argv[2];
+			std::filesystem::create_directories(dir);  // and writable, before the maps are rendered
+			if (const std::string why = whyNotWritable(dir + "/two_robots.bag"); !why.empty())
+				throw std::runtime_error("--write '" + dir + "': " + why);
 			PairSpec spec;
 			spec.ref_resolution = 0.05;
 			spec.other_resolution = 0.08;
 			spec.other_frame = mrpt::poses::CPose2D(1.5, -2.5, 30 * M_PI / 180);
 			const GroundTruthPair pair = makeGroundTruthPair(loadScans(malaga), spec);
-			std::filesystem::create_directories(argv[2]);
-			const std::string dir = argv[2];
 			saveGridMap(pair.ref, dir + "/ref.gridmap.gz");
 			saveGridMap(pair.other, dir + "/other.gridmap.gz");
 			{

@@ -4,6 +4,7 @@
 // --other-log, a fourth robot in another building). Their maps grow step by
 // step as full maps and map updates: what `roslaunch multires_map_merge
 // fleet_demo.launch` plays through the map_merge node. Prints the truth.
+#include <multires_map_merge/MapIO.h>
 #include <multires_map_merge/ros/FleetBag.h>
 
 #include <tclap/CmdLine.h>
@@ -26,6 +27,9 @@ int main(int argc, char** argv)
 	try
 	{
 		cmd.parse(argc, argv);
+		// Found before the maps are rendered, not after.
+		if (const std::string why = whyNotWritable(out_arg.getValue()); !why.empty())
+			throw std::invalid_argument("--out '" + out_arg.getValue() + "': " + why);
 		const double deg = M_PI / 180;
 		std::vector<ros1::FleetBagRobot> robots = {
 			{"/robot1", log_arg.getValue(), 0.0, 0.6, 0.05, {}, 0},

@@ -21,8 +21,6 @@
 #include <fstream>
 #include <iostream>
 
-#include <unistd.h>  // access(): may this process write there
-
 using namespace multires_map_merge;
 
 namespace
@@ -91,21 +89,12 @@ std::vector<std::string> expandTopics(int argc, char** argv)
 	return args;
 }
 
-/** An output that cannot be written is found before the maps are loaded and
- * aligned, not after: its folder must exist and be writable, and an existing
- * file there must be a writable file. Nothing is created or truncated here. */
+/** An output that cannot be written is found before the maps are loaded
+ * and aligned, not after (whyNotWritable). */
 void checkWritable(const std::string& option, const std::string& path)
 {
-	namespace fs = std::filesystem;
-	const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : fs::path(".");
-	std::error_code ec;
-	if (!fs::is_directory(folder, ec))
-		throw UsageError("--" + option + " '" + path + "': no folder '" + folder.string() + "' to write into");
-	if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
-		throw UsageError("--" + option + " '" + path + "': exists and is not a file");
-	const bool writable = fs::exists(path, ec) ? ::access(path.c_str(), W_OK) == 0
-											  : ::access(folder.c_str(), W_OK | X_OK) == 0;
-	if (!writable) throw UsageError("--" + option + " '" + path + "': cannot write there (permission denied)");
+	if (const std::string why = whyNotWritable(path); !why.empty())
+		throw UsageError("--" + option + " '" + path + "': " + why);
 }
 
 void writeText(const std::string& path, const std::string& text)
