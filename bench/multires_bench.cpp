@@ -193,6 +193,7 @@ int fullRun(const BenchContext& ctx, const std::string& out)
 }
 }  // namespace
 
+// Long for its option declarations, one per section that can run alone.
 int main(int argc, char** argv)
 {
 	TCLAP::CmdLine cmd("multires_map_merge benchmark (see bench/README.md)", ' ', "0.1.0");
