@@ -156,14 +156,17 @@ std::vector<HalmstadFleetRun> runHalmstadFleets(
 
 void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleetRun>& runs)
 {
+	const multires_map_merge::FleetParams fleet_defaults;
 	md << "\n## Fleets of real maps (Halmstad)\n\n"
 	   << "Every sensor map of a site in one placement (`placeFleet` + `fuseFleet` in a fresh process, as "
 		  "`gridmap-merge MAP_01 … MAP_n` runs it), the first map the reference; each other map's placement is "
 		  "judged against the annotated similarity to the reference as the pairs are (mean displacement of its "
 		  "occupied pixels, px of 5 cm). *Mixed cells*: the maps recorded ×1, ×2, ×1.4 in turn, all stated "
 		  "0.05 m. *Tree alone*: the same pairs, each map placed through its one most confident path (joint "
-		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree by more than "
-		  "`cycle_tolerance_cells` (" << multires_map_merge::FleetParams{}.cycle_tolerance_cells << ") at the corners of what the map saw; "
+		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree at the corners of what "
+		  "the map saw by more than the tolerance of the cycle's least precise pair (`cycle_tolerance_per_rmse` ("
+	   << fleet_defaults.cycle_tolerance_per_rmse << ") × its edge RMSE, within " << fleet_defaults.cycle_tolerance_cells
+	   << "–" << fleet_defaults.cycle_tolerance_max_cells << " cells); "
 		  "the joint refinement uses only the pairs kept. Each map's displacement and the map it was placed through "
 		  "are printed as the section runs.\n\n"
 	   << "| site | cells | right | wrong | not placed | displacement median [px] | max [px] | tree alone: right | "

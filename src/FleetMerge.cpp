@@ -23,6 +23,13 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
+double FleetParams::toleranceOf(const FleetEdge& e) const
+{
+	const double by_precision = cycle_tolerance_per_rmse * e.rmse_coarse_cells;
+	return std::clamp(std::isfinite(by_precision) ? by_precision : 0.0, cycle_tolerance_cells,
+		std::max(cycle_tolerance_cells, cycle_tolerance_max_cells));
+}
+
 std::string FleetEdge::describe() const
 {
 	return dropped ? "dropped: contradicts the other alignments around a cycle (" + message + ")" : message;
@@ -164,6 +171,7 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 			e.tracked = r.tracked;
 			e.from_to_to = betweenMapFrames(maps[e.to], r.metric, maps[e.from]);
 			e.confidence = r.success ? r.confidence : 0.0;
+			e.rmse_coarse_cells = r.trimmed_rmse_coarse_cells;
 			e.message = r.message;
 		}
 		catch (const std::exception& ex)
@@ -248,36 +256,45 @@ std::vector<int> pathEdges(const Tree& t, size_t a)
 	return out;
 }
 
-/** Builds the tree; while a kept non-tree edge contradicts it, drops the
- * weakest edge of that cycle and rebuilds. */
+/** The cycle that non-tree edge k closes with the tree: k and both tree
+ * paths up to where they meet (the part they share towards the reference is
+ * not on the cycle). */
+std::vector<int> cycleOf(const Tree& t, const std::vector<FleetEdge>& edges, int k)
+{
+	const std::vector<int> up_from = pathEdges(t, edges[k].from), up_to = pathEdges(t, edges[k].to);
+	std::vector<int> cycle = {k};
+	for (const auto* path : {&up_from, &up_to})
+		for (int e : *path)
+			if (std::count(up_from.begin(), up_from.end(), e) + std::count(up_to.begin(), up_to.end(), e) == 1)
+				cycle.push_back(e);
+	return cycle;
+}
+
+/** Builds the tree; while a kept non-tree edge contradicts it (by more than
+ * the tolerance of the cycle's least precise pair), drops the weakest edge of
+ * that cycle and rebuilds. */
 Tree consistentTree(
 	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
 	std::vector<FleetEdge>& edges, const FleetParams& params)
 {
-	const double tol = params.cycle_tolerance_cells;
 	for (;;)
 	{
 		Tree t = spanningTree(maps.size(), reference, edges, params.settled_confidence);
-		int contradicted = -1;
-		for (size_t k = 0; k < edges.size() && contradicted < 0; ++k)
+		std::vector<int> contradicted;
+		for (size_t k = 0; k < edges.size() && contradicted.empty(); ++k)
 		{
 			const FleetEdge& e = edges[k];
 			if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
 			if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
+			const std::vector<int> cycle = cycleOf(t, edges, int(k));
+			double tol = 0;
+			for (int c : cycle) tol = std::max(tol, params.toleranceOf(edges[c]));
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
 			if (disagreementCells(maps[e.from], corners[e.from], maps[e.to], predicted, e.from_to_to) > tol)
-				contradicted = int(k);
+				contradicted = cycle;
 		}
-		if (contradicted < 0) return t;
-		// The cycle: this edge and both tree paths up to where they meet (the
-		// part they share towards the reference is not on the cycle).
-		const std::vector<int> up_from = pathEdges(t, edges[contradicted].from), up_to = pathEdges(t, edges[contradicted].to);
-		std::vector<int> cycle = {contradicted};
-		for (const auto* path : {&up_from, &up_to})
-			for (int k : *path)
-				if (std::count(up_from.begin(), up_from.end(), k) + std::count(up_to.begin(), up_to.end(), k) == 1)
-					cycle.push_back(k);
-		const int weakest = *std::min_element(cycle.begin(), cycle.end(), [&](int a, int b) {
+		if (contradicted.empty()) return t;
+		const int weakest = *std::min_element(contradicted.begin(), contradicted.end(), [&](int a, int b) {
 			return edges[a].confidence < edges[b].confidence;
 		});
 		edges[weakest].dropped = true;
@@ -378,7 +395,9 @@ FleetResult placeFromPairs(
 	out.maps = tree.maps;
 	if (params.joint_refinement)
 	{
-		const auto joint = refineJointly(maps, reference, out.maps, out.edges, corners, params.cycle_tolerance_cells);
+		std::vector<double> tolerance;
+		for (const auto& e : out.edges) tolerance.push_back(params.toleranceOf(e));
+		const auto joint = refineJointly(maps, reference, out.maps, out.edges, corners, tolerance);
 		for (size_t m = 0; m < maps.size(); ++m)
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";

@@ -32,8 +32,8 @@ double coarseCellInReference(
 
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners, double max_move_cells,
-	const JointPlacementParams& params)
+	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
+	const std::vector<double>& tolerance_cells, const JointPlacementParams& params)
 {
 	const size_t n = maps.size();
 	std::vector<std::optional<Similarity2D>> out(n);
@@ -43,10 +43,13 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 	for (size_t m = 0; m < n; ++m)
 		if (m != reference && placements[m].placed) column[m] = 4 * unknowns++;
 	std::vector<size_t> used;
+	std::vector<double> max_move_cells(n, 0.0);  // per map: the largest tolerance of its pairs used
 	for (size_t k = 0; k < edges.size(); ++k)
 	{
 		const FleetEdge& e = edges[k];
-		if (e.merged && !e.dropped && placements[e.from].placed && placements[e.to].placed) used.push_back(k);
+		if (!e.merged || e.dropped || !placements[e.from].placed || !placements[e.to].placed) continue;
+		used.push_back(k);
+		for (size_t m : {e.from, e.to}) max_move_cells[m] = std::max(max_move_cells[m], tolerance_cells[k]);
 	}
 	if (unknowns == 0 || used.size() <= size_t(unknowns)) return out;  // a tree: nothing to balance
 
@@ -60,7 +63,8 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		for (size_t i = 0; i < used.size(); ++i)
 		{
 			const FleetEdge& e = edges[used[i]];
-			const double w = std::sqrt(weight[i]) / coarseCellInReference(maps, placements, e);
+			const double w =
+				std::sqrt(weight[i]) / (coarseCellInReference(maps, placements, e) * tolerance_cells[used[i]]);
 			for (int c = 0; c < 4; ++c)
 			{
 				// T_from(p) − T_to(M(p)) = 0 for the corners p of the from map.
@@ -84,13 +88,14 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		}
 		x = a.colPivHouseholderQr().solve(y);
 		if (!x.allFinite()) return out;
-		// Huber: a pair's weight falls as its disagreement passes robust_cells.
+		// Huber: a pair's weight falls as its disagreement passes robust_share
+		// of its tolerance.
 		for (size_t i = 0; i < used.size(); ++i)
 		{
-			// The rows hold sqrt(weight) / cell × each corner's two coordinates.
+			// The rows hold sqrt(weight) / (cell × tolerance) × each corner's two coordinates.
 			const double r = (a.middleRows(int(i) * 8, 8) * x - y.segment<8>(int(i) * 8)).norm() /
 				(2 * std::sqrt(weight[i]));
-			weight[i] = r <= params.robust_cells ? 1.0 : params.robust_cells / r;
+			weight[i] = r <= params.robust_share ? 1.0 : params.robust_share / r;
 		}
 	}
 	for (size_t m = 0; m < n; ++m)
@@ -102,7 +107,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		const Similarity2D& tree = placements[m].in_reference;
 		const double cell = std::max<double>(
 			maps[reference].grid.getResolution(), maps[m].grid.getResolution() * tree.scale);
-		if (cornersRms(corners[m], joint, tree) / cell <= max_move_cells) out[m] = joint;
+		if (cornersRms(corners[m], joint, tree) / cell <= max_move_cells[m]) out[m] = joint;
 	}
 	return out;
 }

@@ -320,3 +320,39 @@ TEST(FleetGraph, JointRefinementPlacesAChainedMapByEveryPairThatSeesIt)
 	EXPECT_EQ(joint.maps[3].parent, 2);
 	EXPECT_DOUBLE_EQ(joint.maps[3].confidence, 0.99);
 }
+
+TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)
+{
+	// Map 2 is placed through map 1 (the surer path); the direct pair 0 <- 2 is
+	// 8 cells (0.8 m) off it. Pairs of precise maps (edge RMSE 0.3 cells) that
+	// far apart mean one is off: the direct pair is dropped and map 2 stays where
+	// its path puts it. Pairs of bent maps fitting at an edge RMSE of 3 cells
+	// disagree that much when both are right: the pair is kept and the joint
+	// refinement places map 2 between them.
+	const std::vector<Similarity2D> truth = {{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1, -0.5, {-3, 4})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	Similarity2D direct = between(2, 0);
+	direct.t += Eigen::Vector2d(0.8, 0);
+	auto placed = [&](double rmse_cells) {
+		std::vector<FleetEdge> edges = {
+			edge(1, 0, between(1, 0), 0.99), edge(2, 1, between(2, 1), 0.99), edge(2, 0, direct, 0.7)};
+		for (auto& e : edges) e.rmse_coarse_cells = rmse_cells;
+		return placeFromPairs(blankMaps(3), 0, edges);
+	};
+	const std::vector<GridInFrame> maps = blankMaps(3);
+	const FleetParams defaults;
+	EXPECT_DOUBLE_EQ(defaults.toleranceOf(edge(2, 0, {}, 1)), defaults.cycle_tolerance_cells);  // no RMSE: the floor
+
+	const FleetResult precise = placed(0.3);
+	EXPECT_TRUE(precise.edges[2].dropped);
+	expectNear(precise.maps[2].in_reference, truth[2]);
+
+	const FleetResult bent = placed(3.0);
+	EXPECT_FALSE(bent.edges[2].dropped);
+	const double off_path = cornerRms(maps[2], bent.maps[2].in_reference, truth[2]) / 0.1,
+				 off_direct = cornerRms(maps[2], bent.maps[2].in_reference, truth[0].compose(direct)) / 0.1;
+	EXPECT_GT(off_path, 1.0);
+	EXPECT_GT(off_direct, 1.0);
+	EXPECT_NEAR(off_path + off_direct, 8.0, 0.5);
+	EXPECT_NE(bent.maps[2].message.find("refined jointly"), std::string::npos) << bent.maps[2].message;
+}

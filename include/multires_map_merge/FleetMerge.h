@@ -28,6 +28,10 @@ struct FleetEdge
 	bool merged = false;  //!< the aligner was confident
 	Similarity2D from_to_to;
 	double confidence = 0;
+	/** The aligner's edge RMSE (cells of the coarser map of the pair): how
+	 * precisely the pair agrees. Renderings of one corrected log fit below a
+	 * cell; two SLAM runs of one building bend apart and fit at 1–10. */
+	double rmse_coarse_cells = 0;
 	std::string message;  //!< the aligner's
 	bool dropped = false;  //!< contradicted the others around a cycle
 	bool reused = false;  //!< an earlier result (FleetHints::known), not aligned in this call
@@ -59,12 +63,21 @@ struct FleetParams
 	 * promising first, for a surer path. */
 	size_t unsettled_tries = 2;
 	/** A cycle whose composed transform moves the corners of what a map saw
-	 * by more than this many cells of the coarser map (RMS) is contradictory.
-	 * Tight on purpose: two pairs of precise maps 4 cells apart means one is
-	 * off, and the joint refinement would land between them. Right pairs of
-	 * bent real maps disagree by 2–35 cells, so there the check drops most
-	 * redundant pairs, keeping the tree's (docs/method.md, limit). */
+	 * by more than its tolerance (cells of the coarser map, RMS) is
+	 * contradictory. A pair's tolerance follows its precision:
+	 * `cycle_tolerance_per_rmse` × its edge RMSE, at least
+	 * `cycle_tolerance_cells` and at most `cycle_tolerance_max_cells`; a
+	 * cycle's is that of its least precise pair. Tight for precise pairs on
+	 * purpose: two pairs of precise maps 4 cells apart means one is off, and
+	 * the joint refinement would land between them. Right pairs of bent real
+	 * maps disagree by 2–35 cells and fit at an RMSE of 1–10 cells. */
 	double cycle_tolerance_cells = 3.0;
+	double cycle_tolerance_per_rmse = 4.0;
+	/** Farther apart, two placements are rivals to the decision, not one
+	 * (DecisionParams::distinct_shift). */
+	double cycle_tolerance_max_cells = DecisionParams{}.distinct_shift;
+	/** The tolerance of one pair (see cycle_tolerance_cells). */
+	double toleranceOf(const FleetEdge& e) const;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */

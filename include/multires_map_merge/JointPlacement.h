@@ -16,24 +16,27 @@ namespace multires_map_merge
 struct JointPlacementParams
 {
 	/** Iteratively reweighted least squares: a pair that disagrees with the
-	 * joint placement by more than this many cells of its coarser map (RMS
-	 * over the corners of the `from` map's content) counts less (Huber), so
-	 * one bad pair cannot pull the others. */
-	double robust_cells = 1.0;
+	 * joint placement by more than this share of its tolerance (RMS over the
+	 * corners of the `from` map's content) counts less (Huber), so one bad
+	 * pair cannot pull the others. */
+	double robust_share = 1.0 / 3;
 	int reweighting_rounds = 5;
 };
 
 /** Every placed map's pose in the reference's frame (`in_reference` of each
  * placed map; the reference fixed) refined from every confident pair that is
  * not dropped and joins two placed maps, each weighed at the corners of its
- * `from` map's content (`corners`, one per map). A map whose refined pose
- * moves its content by more than `max_move_cells` from its tree placement
- * keeps the tree's (the cycle check admits pairs within that much of each other: a
- * larger move means the pairs do not support one placement). Returns, per
- * map, the refined pose, or nothing where the tree's stays. */
+ * `from` map's content (`corners`, one per map) in units of its tolerance
+ * (`tolerance_cells`, one per edge, cells of its coarser map: FleetParams::
+ * toleranceOf), so a precise pair counts more than one of bent maps. A map
+ * whose refined pose moves its content by more than the largest tolerance of
+ * its pairs from its tree placement keeps the tree's (the cycle check admits
+ * pairs within that much of each other: a larger move means the pairs do not
+ * support one placement). Returns, per map, the refined pose, or nothing
+ * where the tree's stays. */
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners, double max_move_cells,
-	const JointPlacementParams& params = {});
+	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
+	const std::vector<double>& tolerance_cells, const JointPlacementParams& params = {});
 
 }  // namespace multires_map_merge
