@@ -117,6 +117,19 @@ void runCoarserCalibrationPairs(const BenchContext& ctx, const HalmstadData& dat
 	fs::remove_all(dir);
 }
 
+/** Floor plans: each E5 and HIH sensor map (OTHER) on its own site's plan
+ * (positives, judged against the annotation) and on every other site's plan
+ * (negatives), as the floor-plan section aligns them. */
+void runFloorPlanCalibrationPairs(const BenchContext& ctx, const HalmstadData& data)
+{
+	const std::string dir = ctx.tempDir("plans");
+	for (const std::string site : {"E5", "HIH"})
+		for (const auto& sensor : data.sensorMaps(site))
+			for (const auto& plan_site : data.sites())
+				runHalmstadPair(ctx, data, HalmstadData::floorPlan(plan_site), sensor, dir);
+	fs::remove_all(dir);
+}
+
 /** Calibration negatives in the other order: each map of another site as
  * REF against `per_map` E5 maps as OTHER. The decision is not symmetric in
  * its maps, and the report's cross-site negatives take every site's maps as
@@ -152,7 +165,7 @@ void runReverseCalibrationPositives(const BenchContext& ctx, const HalmstadData&
 void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts)
 {
 	const HalmstadData data(ctx.data + "/halmstad");
-	const bool everything = !parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs;
+	const bool everything = !parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs && !parts.floor_plan_pairs;
 	if (everything)
 	{
 		runHalmstad(ctx, data, {"E5", "HIH"}, parts.negatives_per_map);
@@ -163,6 +176,7 @@ void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts
 	if (everything || parts.extra_negatives) runExtraCalibrationNegatives(ctx, data);
 	if (everything || parts.live_pairs) runLiveFleetCalibrationPairs(ctx);
 	if (everything || parts.coarser_pairs) runCoarserCalibrationPairs(ctx, data);
+	if (everything || parts.floor_plan_pairs) runFloorPlanCalibrationPairs(ctx, data);
 }
 
 }  // namespace multires_bench

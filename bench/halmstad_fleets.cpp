@@ -166,7 +166,7 @@ void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleet
 		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree at the corners of what "
 		  "the map saw by more than the tolerance of the cycle's least precise pair (`cycle_tolerance_per_rmse` ("
 	   << fleet_defaults.cycle_tolerance_per_rmse << ") × its edge RMSE, within " << fleet_defaults.cycle_tolerance_cells
-	   << "–" << fleet_defaults.cycle_tolerance_max_cells << " cells); "
+	   << "–" << fleet_defaults.maxToleranceCells() << " cells); "
 		  "the joint refinement uses only the pairs kept. Each map's displacement and the map it was placed through "
 		  "are printed as the section runs.\n\n"
 	   << "| site | cells | right | wrong | not placed | displacement median [px] | max [px] | tree alone: right | "

@@ -210,6 +210,8 @@ int main(int argc, char** argv)
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
 	TCLAP::SwitchArg coarser_pairs_arg(
 		"", "coarser-pairs-only", "with --calibration-data: only the E5 and HIH pairs with OTHER recorded coarser", cmd);
+	TCLAP::SwitchArg floor_plan_pairs_arg(
+		"", "floor-plan-pairs-only", "with --calibration-data: only the E5 and HIH sensor maps on every site's floor plan", cmd);
 	TCLAP::SwitchArg live_pairs_arg(
 		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
 	TCLAP::ValueArg<std::string> coarser_arg(
@@ -282,7 +284,7 @@ int main(int argc, char** argv)
 			// screen's included), of every pair, not on those a decision kept.
 			ctx.options.exhaustive_search = true;
 			writeCalibrationData(ctx, {extra_arg.getValue(), live_pairs_arg.getValue(), coarser_pairs_arg.getValue(),
-									   size_t(negatives_arg.getValue())});
+									   floor_plan_pairs_arg.getValue(), size_t(negatives_arg.getValue())});
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
 		}

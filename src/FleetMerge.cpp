@@ -27,7 +27,12 @@ double FleetParams::toleranceOf(const FleetEdge& e) const
 {
 	const double by_precision = cycle_tolerance_per_rmse * e.rmse_coarse_cells;
 	return std::clamp(std::isfinite(by_precision) ? by_precision : 0.0, cycle_tolerance_cells,
-		std::max(cycle_tolerance_cells, cycle_tolerance_max_cells));
+		std::max(cycle_tolerance_cells, maxToleranceCells()));
+}
+
+double FleetParams::maxToleranceCells() const
+{
+	return cycle_tolerance_max_cells.value_or(DecisionParams{}.distinct_shift);
 }
 
 std::string FleetEdge::describe() const
@@ -431,8 +436,11 @@ FleetResult placeFromPairs(
 
 FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
-	const FleetParams& params, const FleetHints& hints)
+	const FleetParams& given_params, const FleetHints& hints)
 {
+	// Two placements the aligner's decision tells apart are never one.
+	FleetParams params = given_params;
+	if (!params.cycle_tolerance_max_cells) params.cycle_tolerance_max_cells = aligner.options.decision.distinct_shift;
 	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();

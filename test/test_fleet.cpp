@@ -342,6 +342,13 @@ TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)
 	const std::vector<GridInFrame> maps = blankMaps(3);
 	const FleetParams defaults;
 	EXPECT_DOUBLE_EQ(defaults.toleranceOf(edge(2, 0, {}, 1)), defaults.cycle_tolerance_cells);  // no RMSE: the floor
+	// At most what the decision tells apart as rival placements (unset: its default).
+	FleetEdge loose = edge(2, 0, {}, 1);
+	loose.rmse_coarse_cells = 100;
+	EXPECT_DOUBLE_EQ(defaults.toleranceOf(loose), DecisionParams{}.distinct_shift);
+	FleetParams narrower;
+	narrower.cycle_tolerance_max_cells = 25;
+	EXPECT_DOUBLE_EQ(narrower.toleranceOf(loose), 25);
 
 	const FleetResult precise = placed(0.3);
 	EXPECT_TRUE(precise.edges[2].dropped);

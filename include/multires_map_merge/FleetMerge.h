@@ -73,11 +73,14 @@ struct FleetParams
 	 * maps disagree by 2–35 cells and fit at an RMSE of 1–10 cells. */
 	double cycle_tolerance_cells = 3.0;
 	double cycle_tolerance_per_rmse = 4.0;
-	/** Farther apart, two placements are rivals to the decision, not one
-	 * (DecisionParams::distinct_shift). */
-	double cycle_tolerance_max_cells = DecisionParams{}.distinct_shift;
+	/** Farther apart, two placements are rivals to the decision, not one.
+	 * Unset: the decision's `distinct_shift` (placeFleet: its aligner's;
+	 * placeFromPairs, which has none: the default). */
+	std::optional<double> cycle_tolerance_max_cells;
 	/** The tolerance of one pair (see cycle_tolerance_cells). */
 	double toleranceOf(const FleetEdge& e) const;
+	/** The largest tolerance: cycle_tolerance_max_cells, or its default. */
+	double maxToleranceCells() const;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */
