@@ -27,6 +27,7 @@ int main(int argc, char** argv)
 		if (max_merged_cells < 1) throw std::invalid_argument(std::string("~") + max_cells_key + " must be >= 1");
 		service = std::make_unique<ros1::MergeMapsService>(ros1::alignerParamsFromRos(pnh, {threads_key, max_cells_key}));
 		service->max_merged_cells = static_cast<size_t>(max_merged_cells);
+		service->fleet_params = ros1::fleetParamsFromRos(pnh);
 	}
 	catch (const std::exception& e)
 	{

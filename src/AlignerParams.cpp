@@ -2,6 +2,8 @@
 // loading, saving, validation, the ROS keys and README's table all read.
 #include <multires_map_merge/CScalingGridMapAligner.h>
 
+#include "ParamText.h"
+
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/core/format.h>
 
@@ -12,6 +14,7 @@
 namespace multires_map_merge
 {
 using P = CScalingGridMapAligner::TConfigParams;
+using namespace param_text;
 
 const std::vector<AlignerParamField>& alignerParamFields()
 {
@@ -80,54 +83,9 @@ std::vector<std::string> alignerParamKeys()
 	return keys;
 }
 
-namespace
-{
-/** The shortest text that reads back as `v` exactly: MRPT writes doubles
- * with "%f", which saved icp_relative_tolerance (1e-7) as 0. */
-std::string exactText(double v)
-{
-	for (int digits = 6; digits < 17; ++digits)
-		if (const std::string t = mrpt::format("%.*g", digits, v); std::stod(t) == v) return t;
-	return mrpt::format("%.17g", v);
-}
-
-std::string valueText(const P& params, const AlignerParamField& f)
-{
-	return std::visit(
-		[&](auto member) -> std::string {
-			const auto v = params.*member;
-			if constexpr (std::is_same_v<decltype(v), const bool>) return v ? "true" : "false";
-			else return exactText(v);
-		},
-		f.member);
-}
-
-bool isBool(const AlignerParamField& f) { return std::holds_alternative<bool P::*>(f.member); }
-
-void writeKey(
-	mrpt::config::CConfigFileBase& c, const std::string& s, const char* key, const std::string& value, const char* what)
-{
-	c.write(s, key, value, mrpt::config::MRPT_SAVE_NAME_PADDING(), mrpt::config::MRPT_SAVE_VALUE_PADDING(), what);
-}
-
-std::string rangeText(double lo, double hi, bool zero_turns_off)
-{
-	return mrpt::format("%s[%g, %g]", zero_turns_off ? "0 or " : "", lo, hi);
-}
-}  // namespace
-
 void P::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	for (const auto& f : alignerParamFields())
-		std::visit(
-			[&](auto member) {
-				auto& v = this->*member;
-				using T = std::remove_reference_t<decltype(v)>;
-				if constexpr (std::is_same_v<T, bool>) v = c.read_bool(s, f.key, v);
-				else if constexpr (std::is_same_v<T, int>) v = c.read_int(s, f.key, v);
-				else v = c.read_double(s, f.key, v);
-			},
-			f.member);
+	for (const auto& f : alignerParamFields()) readField(*this, f.member, c, s, f.key);
 	for (const auto& f : decisionParamFields()) decision.*f.member = c.read_double(s, f.key, decision.*f.member);
 	if (const std::string why = invalidReason(); !why.empty())
 		throw std::invalid_argument("[" + s + "] " + why);
@@ -135,20 +93,14 @@ void P::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::st
 
 void P::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	for (const auto& f : alignerParamFields()) writeKey(c, s, f.key, valueText(*this, f), f.description);
+	for (const auto& f : alignerParamFields()) writeKey(c, s, f.key, valueText(*this, f.member), f.description);
 	for (const auto& f : decisionParamFields()) writeKey(c, s, f.key, exactText(decision.*f.member), f.comment);
 }
 
 std::string P::invalidReason() const
 {
 	for (const auto& f : alignerParamFields())
-	{
-		if (isBool(f)) continue;
-		const double v = std::visit([&](auto member) { return static_cast<double>(this->*member); }, f.member);
-		if (f.zero_turns_off && v == 0) continue;
-		if (!(v >= f.lo && v <= f.hi))
-			return mrpt::format("%s = %g is outside %s", f.key, v, rangeText(f.lo, f.hi, f.zero_turns_off).c_str());
-	}
+		if (std::string why = outOfRange(*this, f.member, f.key, f.lo, f.hi, f.zero_turns_off); !why.empty()) return why;
 	return decision.invalidReason();
 }
 
@@ -158,8 +110,7 @@ std::string alignerParamsMarkdown()
 	std::ostringstream md;
 	md << "| key | default | valid | meaning |\n|---|---|---|---|\n";
 	for (const auto& f : alignerParamFields())
-		md << "| `" << f.key << "` | " << valueText(defaults, f) << " | "
-		   << (isBool(f) ? "true, false" : rangeText(f.lo, f.hi, f.zero_turns_off)) << " | " << f.description << " |\n";
+		md << markdownRow(defaults, f.member, f.key, f.lo, f.hi, f.zero_turns_off, f.description);
 	for (const auto& f : decisionParamFields())
 		if (std::string(f.key) == "min_confidence")
 			md << "| `" << f.key << "` | " << exactText(defaults.decision.*f.member) << " | "

@@ -32,7 +32,7 @@ double FleetParams::toleranceOf(const FleetEdge& e) const
 
 double FleetParams::maxToleranceCells() const
 {
-	return cycle_tolerance_max_cells.value_or(DecisionParams{}.distinct_shift);
+	return cycle_tolerance_max_cells > 0 ? cycle_tolerance_max_cells : DecisionParams{}.distinct_shift;
 }
 
 std::string FleetEdge::describe() const
@@ -438,9 +438,11 @@ FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
 	const FleetParams& given_params, const FleetHints& hints)
 {
+	if (const std::string why = given_params.invalidReason(); !why.empty())
+		throw std::invalid_argument("invalid fleet parameters: " + why);
 	// Two placements the aligner's decision tells apart are never one.
 	FleetParams params = given_params;
-	if (!params.cycle_tolerance_max_cells) params.cycle_tolerance_max_cells = aligner.options.decision.distinct_shift;
+	if (!(params.cycle_tolerance_max_cells > 0)) params.cycle_tolerance_max_cells = aligner.options.decision.distinct_shift;
 	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();

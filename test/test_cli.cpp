@@ -1,6 +1,7 @@
 // gridmap-merge end to end on real data: every input format, outputs, JSON
 // against ground truth, exit codes.
 #include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
@@ -137,6 +138,7 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 	const std::string d = dir();
 	std::ofstream(d + "/garbage.gridmap.gz") << "garbage";
 	saveGridMap(malagaPair().ref, d + "/ok.gridmap.gz");
+	std::ofstream(d + "/bad_fleet.ini") << "[fleet]\nunsettled_tries = -2\n";
 	struct Bad
 	{
 		std::string args, words;
@@ -147,6 +149,7 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --output-resolution fine", "--output-resolution"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --out x.png", "--out must end"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --config " + d + "/none.ini", "none.ini': no such config"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --config " + d + "/bad_fleet.ini", "[fleet] unsettled_tries"},
 			 Bad{d + "/ok.gridmap.gz", "OTHER"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --bogus", "bogus"},
 			 // A file option followed by another option: no file named "--png".
@@ -214,5 +217,10 @@ TEST(Cli, ParametersAsReadmeListsThemAndWrittenAsAnIni)
 	loaded.loadFromConfigFile(mrpt::config::CConfigFile(ini), "aligner");
 	EXPECT_EQ(loaded.xi_min, CScalingGridMapAligner::TConfigParams().xi_min);
 	EXPECT_EQ(loaded.decision.threshold, CScalingGridMapAligner::TConfigParams().decision.threshold);
+	for (const auto& f : fleetParamFields()) EXPECT_NE(text.find(std::string(f.key) + " "), std::string::npos) << f.key;
+	FleetParams fleet;
+	fleet.joint_refinement = false;
+	fleet.loadFromConfigFile(mrpt::config::CConfigFile(ini), "fleet");
+	EXPECT_TRUE(fleet.joint_refinement) << "the default, written and read back";
 	EXPECT_EQ(runCli("--write-config " + ini + " " + ini).exit_code, 2) << "maps with --write-config";
 }

@@ -8,6 +8,9 @@
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
 
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -203,6 +206,48 @@ TEST(Fleet, RefusesTooFewMapsAndABadReference)
 	EXPECT_THROW(placeFleet(one, 0, CScalingGridMapAligner()), std::invalid_argument);
 	std::vector<GridInFrame> two(2);
 	EXPECT_THROW(placeFleet(two, 2, CScalingGridMapAligner()), std::invalid_argument);
+	FleetParams bad;
+	bad.settled_confidence = std::nan("");
+	EXPECT_THROW(placeFleet(two, 0, CScalingGridMapAligner(), bad), std::invalid_argument);
+}
+
+// Every fleet key is written and reads back; a bad value is refused naming
+// its section and key.
+TEST(Fleet, ParametersReadBackFromAnIniAndBadOnesAreNamed)
+{
+	FleetParams set;
+	set.threads = 3, set.settled_confidence = 0.7, set.unsettled_tries = 4, set.cycle_tolerance_cells = 2.5;
+	set.cycle_tolerance_per_rmse = 6, set.cycle_tolerance_max_cells = 25, set.joint_refinement = false;
+	const std::string path = tmpDir() + "/fleet.ini";
+	{
+		mrpt::config::CConfigFile ini(path);
+		set.saveToConfigFile(ini, "fleet");
+	}  // written when closed
+	FleetParams read;
+	read.loadFromConfigFile(mrpt::config::CConfigFile(path), "fleet");
+	EXPECT_EQ(read.threads, 3u);
+	EXPECT_EQ(read.settled_confidence, 0.7);
+	EXPECT_EQ(read.unsettled_tries, 4u);
+	EXPECT_EQ(read.cycle_tolerance_cells, 2.5);
+	EXPECT_EQ(read.cycle_tolerance_per_rmse, 6);
+	EXPECT_EQ(read.cycle_tolerance_max_cells, 25);
+	EXPECT_FALSE(read.joint_refinement);
+	for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+			 {"unsettled_tries", "-1"}, {"fleet_threads", "1.5"}, {"settled_confidence", "2"},
+			 {"cycle_tolerance_cells", "0"}, {"cycle_tolerance_max_cells", "-3"}})
+	{
+		mrpt::config::CConfigFileMemory bad;
+		bad.write("fleet", key, value);
+		try
+		{
+			FleetParams().loadFromConfigFile(bad, "fleet");
+			ADD_FAILURE() << key << " = " << value << " was taken";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find("[fleet] " + key), std::string::npos) << e.what();
+		}
+	}
 }
 
 namespace

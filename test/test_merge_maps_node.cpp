@@ -2,10 +2,14 @@
 // with the ground truth, publishes the merged map latched, refuses every bad
 // input without dying, and takes its parameters from an ini file and the
 // parameter server.
+#include <multires_map_merge/ros/AlignerParamsFromRos.h>
+
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "ros_test_maps.h"
@@ -83,6 +87,35 @@ TEST(MergeMapsNode, IniFileIsReadAndPrivateParametersOverrideIt)
 	// The same ini with ~ransac_min_inliers: 5 merges.
 	const MergeMaps::Response overridden = call("/ini_overridden/merge_maps", validRequest(pair()));
 	expectTransformMatchesTruth(overridden, pair());
+}
+
+// The fleet's parameters (merge_fleet, map_merge) come the same way: [fleet]
+// of ~config_file, then private parameters of the same names; a bad one is
+// refused naming it.
+TEST(MergeMapsNode, FleetParametersFromTheIniFileAndTheServer)
+{
+	const std::string ns = "/fleet_params_check";
+	const std::string ini = std::filesystem::temp_directory_path() / "mmm_fleet_params.ini";
+	std::ofstream(ini) << "[fleet]\nsettled_confidence = 0.8\nunsettled_tries = 5\njoint_refinement = false\n";
+	ros::param::set(ns + "/config_file", ini);
+	ros::param::set(ns + "/unsettled_tries", 7);
+	const FleetParams p = ros1::fleetParamsFromRos(ros::NodeHandle(ns));
+	EXPECT_EQ(p.settled_confidence, 0.8);  // the ini's
+	EXPECT_FALSE(p.joint_refinement);
+	EXPECT_EQ(p.unsettled_tries, 7u);  // the server's, over the ini's 5
+	EXPECT_EQ(p.cycle_tolerance_cells, FleetParams().cycle_tolerance_cells);  // the default
+	ros::param::set(ns + "/settled_confidence", 1.5);
+	try
+	{
+		ros1::fleetParamsFromRos(ros::NodeHandle(ns));
+		ADD_FAILURE() << "settled_confidence 1.5 was taken";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("settled_confidence"), std::string::npos) << e.what();
+	}
+	ros::param::del(ns);
+	std::filesystem::remove(ini);
 }
 
 int main(int argc, char** argv)

@@ -17,7 +17,13 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
 
 namespace multires_map_merge
 {
@@ -74,9 +80,9 @@ struct FleetParams
 	double cycle_tolerance_cells = 3.0;
 	double cycle_tolerance_per_rmse = 4.0;
 	/** Farther apart, two placements are rivals to the decision, not one.
-	 * Unset: the decision's `distinct_shift` (placeFleet: its aligner's;
+	 * 0: the decision's `distinct_shift` (placeFleet: its aligner's;
 	 * placeFromPairs, which has none: the default). */
-	std::optional<double> cycle_tolerance_max_cells;
+	double cycle_tolerance_max_cells = 0;
 	/** The tolerance of one pair (see cycle_tolerance_cells). */
 	double toleranceOf(const FleetEdge& e) const;
 	/** The largest tolerance: cycle_tolerance_max_cells, or its default. */
@@ -85,7 +91,32 @@ struct FleetParams
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */
 	bool joint_refinement = true;
+
+	/** Reads `section` of an MRPT ini file (keys: fleetParamFields(); absent
+	 * keys keep their values). Throws std::invalid_argument naming the
+	 * section and the key whose value cannot work. */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& section);
+	/** Writes every key with its meaning. */
+	void saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& section) const;
+	/** Why these values cannot work ("" when they can). */
+	std::string invalidReason() const;
 };
+
+/** One fleet parameter: its ini key (section [fleet]; the ROS parameter of
+ * the same name), its member, its valid range (0 also valid where it turns
+ * the setting to its default) and what it sets. Loading, saving,
+ * validation, the ROS nodes and README's table read this one list. */
+struct FleetParamField
+{
+	const char* key;
+	std::variant<double FleetParams::*, unsigned FleetParams::*, size_t FleetParams::*, bool FleetParams::*> member;
+	double lo, hi;
+	bool zero_is_default;
+	const char* description;
+};
+const std::vector<FleetParamField>& fleetParamFields();
+/** README's fleet parameter table: key, default, valid range, description. */
+std::string fleetParamsMarkdown();
 
 /** What a caller that places the same fleet again and again (LiveFleet, as
  * the maps grow) knows from before, so that a call costs what changed. */
@@ -156,7 +187,8 @@ FleetResult placeFromPairs(
 	const FleetParams& params = {});
 
 /** Places every map in `maps[reference]`'s frame. Throws std::invalid_argument
- * on fewer than two maps or a reference out of range. */
+ * on fewer than two maps, a reference out of range or parameters that cannot
+ * work (FleetParams::invalidReason). */
 FleetResult placeFleet(
 	const std::vector<GridInFrame>& maps, size_t reference, const CScalingGridMapAligner& aligner,
 	const FleetParams& params = {}, const FleetHints& hints = {});

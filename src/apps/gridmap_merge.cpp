@@ -109,10 +109,10 @@ void writeText(const std::string& path, const std::string& text)
  * map is placed, 1 when one is not (the merged map of those placed is still
  * written, and the JSON says which and why). */
 int mergeFleet(
-	const Inputs& in, const CScalingGridMapAligner& aligner, const std::string& outres, const std::string& json,
-	const std::string& out, const std::string& png, mrpt::system::CTicTac& clock)
+	const Inputs& in, const CScalingGridMapAligner& aligner, const FleetParams& fleet, const std::string& outres,
+	const std::string& json, const std::string& out, const std::string& png, mrpt::system::CTicTac& clock)
 {
-	const FleetResult r = placeFleet(in.maps, 0, aligner);
+	const FleetResult r = placeFleet(in.maps, 0, aligner, fleet);
 	std::cout << "aligned " << r.pairs_aligned << " pairs, skipped " << r.pairs_skipped << "\n";
 	double finest = in.maps[0].grid.getResolution();
 	for (size_t m = 1; m < in.maps.size(); ++m)
@@ -187,13 +187,16 @@ Request parseCommandLine(int argc, char** argv)
 	TCLAP::ValueArg<std::string> png_arg(
 		"", "png", "write an overlay PNG (black both, blue REF only, red OTHER only; a colour per map for 3+)", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> config_arg(
-		"", "config", "aligner parameters, section [aligner] of an MRPT ini file", false, "", "FILE.ini", cmd);
+		"", "config", "parameters: sections [aligner] and [fleet] (3 maps or more) of an MRPT ini file", false, "",
+		"FILE.ini", cmd);
 	TCLAP::ValueArg<std::string> write_config_arg(
 		"", "write-config",
-		"write every aligner parameter (defaults, or --config's) with its meaning as an ini file, and exit", false,
+		"write every aligner and fleet parameter (defaults, or --config's) with its meaning as an ini file, and exit",
+		false,
 		"", "FILE.ini", cmd);
 	TCLAP::SwitchArg parameters_arg(
-		"", "parameters", "print every aligner parameter: key, default, valid range, meaning (README's table)", cmd);
+		"", "parameters", "print every aligner and fleet parameter: key, default, valid range, meaning (README's tables)",
+		cmd);
 	TCLAP::SwitchArg metadata_arg(
 		"", "use-resolution-metadata", "use the stated resolutions as a scale prior", cmd);
 	TCLAP::ValueArg<std::string> outres_arg(
@@ -314,18 +317,25 @@ int main(int argc, char** argv)
 		json = q.json;
 		if (q.parameters)
 		{
-			std::cout << alignerParamsMarkdown();
+			std::cout << alignerParamsMarkdown() << "\nSection `[fleet]` (three maps or more):\n\n" << fleetParamsMarkdown();
 			return kMerged;
 		}
 		checkRequest(q);
 		CScalingGridMapAligner aligner;
-		if (!q.config.empty()) aligner.options.loadFromConfigFile(mrpt::config::CConfigFile(q.config), "aligner");
+		FleetParams fleet;
+		if (!q.config.empty())
+		{
+			const mrpt::config::CConfigFile ini(q.config);
+			aligner.options.loadFromConfigFile(ini, "aligner");
+			fleet.loadFromConfigFile(ini, "fleet");
+		}
 		if (q.use_resolution_metadata) aligner.options.use_resolution_metadata = true;
 		if (q.verbose) aligner.setMinLoggingLevel(mrpt::system::LVL_DEBUG);
 		if (!q.write_config.empty())
 		{
 			mrpt::config::CConfigFile ini(q.write_config);
 			aligner.options.saveToConfigFile(ini, "aligner");
+			fleet.saveToConfigFile(ini, "fleet");
 			ini.writeNow();
 			std::cout << "wrote " << q.write_config << "\n";
 			return kMerged;
@@ -340,7 +350,7 @@ int main(int argc, char** argv)
 		for (size_t m = 0; m < in.maps.size(); ++m)
 			std::cout << (m ? "OTHER " : "REF   ") << in.names[m] << ": " << in.maps[m].grid.getSizeX() << "x"
 					  << in.maps[m].grid.getSizeY() << " cells, stated " << in.maps[m].grid.getResolution() << " m\n";
-		return mergeFleet(in, aligner, q.output_resolution, q.json, q.out, q.png, clock);
+		return mergeFleet(in, aligner, fleet, q.output_resolution, q.json, q.out, q.png, clock);
 	}
 	catch (const TCLAP::ArgException& e)
 	{

@@ -65,12 +65,34 @@ CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
 		{
 			if (name.compare(0, prefix.size(), prefix) != 0) continue;
 			const std::string key = name.substr(prefix.size());
+			const auto& fleet = fleetParamFields();
 			const bool known = std::count(keys.begin(), keys.end(), key) ||
+							   std::any_of(fleet.begin(), fleet.end(), [&](const auto& f) { return key == f.key; }) ||
 							   std::count(node_keys.begin(), node_keys.end(), key) ||
 							   key == "config_file" || key == "config_section";
 			if (!known) ROS_WARN_STREAM("parameter " << name << " is not one this node reads; ignored");
 		}
 	}
+	return params;
+}
+
+FleetParams fleetParamsFromRos(const ros::NodeHandle& pnh)
+{
+	FleetParams params;
+	std::string config_file;
+	if (pnh.getParam("config_file", config_file) && !config_file.empty())
+	{
+		if (!std::filesystem::is_regular_file(config_file))
+			throw std::invalid_argument("~config_file '" + config_file + "': no such file");
+		params.loadFromConfigFile(mrpt::config::CConfigFile(config_file), "fleet");
+	}
+	mrpt::config::CConfigFileMemory overrides;
+	for (const auto& f : fleetParamFields())
+	{
+		XmlRpc::XmlRpcValue v;
+		if (pnh.getParam(f.key, v)) overrides.write("fleet", f.key, asIniValue(f.key, v));
+	}
+	params.loadFromConfigFile(overrides, "fleet");
 	return params;
 }
 

@@ -24,6 +24,8 @@ LiveFleet::LiveFleet(const LiveFleetParams& params) : params_(params)
 {
 	if (const std::string why = params_.aligner.invalidReason(); !why.empty())
 		throw std::invalid_argument("invalid aligner parameters: " + why);
+	if (const std::string why = params_.placement.invalidReason(); !why.empty())
+		throw std::invalid_argument("invalid fleet parameters: " + why);
 	if (!(params_.output_resolution >= 0) || !std::isfinite(params_.output_resolution))
 		throw std::invalid_argument("output_resolution must be 0 (the world robot's) or metres > 0");
 	if (!(params_.agreement_cells > 0)) throw std::invalid_argument("agreement_cells must be > 0");
@@ -296,7 +298,7 @@ void LiveFleet::estimate()
 			const FleetHints hints = hintsFor(s, started);
 			CScalingGridMapAligner aligner;
 			aligner.options = params_.aligner;
-			result = placeFleet(s.maps, world, aligner, {}, hints);
+			result = placeFleet(s.maps, world, aligner, params_.placement, hints);
 			stats.pairs_aligned = result->pairs_aligned, stats.pairs_reused = result->pairs_reused;
 			stats.pairs_deferred = result->pairs_deferred, stats.pairs_skipped = result->pairs_skipped;
 			stats.maps_prepared = size_t(std::count(hints.prepared.begin(), hints.prepared.end(), nullptr));

@@ -83,6 +83,7 @@ MapMergeConfig MapMergeConfig::fromParams(const ros::NodeHandle& pnh)
 
 	LiveFleetParams& f = c.fleet;
 	f.aligner = alignerParamsFromRos(pnh, node_keys);
+	f.placement = fleetParamsFromRos(pnh);
 	// m-explore's threshold, default 1.0, maps onto our confidence at half:
 	// 1.0 → 0.5, the calibrated default; min_confidence wins if set.
 	if (!pnh.hasParam("min_confidence")) f.aligner.decision.min_confidence = 0.5 * s.estimation_confidence;

@@ -110,7 +110,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 		CScalingGridMapAligner aligner;
 		aligner.options = params_;
 		aligner.options.use_resolution_metadata = params_.use_resolution_metadata || req.use_resolution_metadata;
-		const FleetResult r = placeFleet(maps, req.reference, aligner);
+		const FleetResult r = placeFleet(maps, req.reference, aligner, fleet_params);
 		res.pairs_aligned = r.pairs_aligned;
 		res.pairs_skipped = r.pairs_skipped;
 		size_t placed = 0;

@@ -31,6 +31,8 @@ namespace multires_map_merge::ros1
 struct LiveFleetParams
 {
 	CScalingGridMapAligner::TConfigParams aligner;
+	/** How each estimation places the robots' maps (FleetMerge.h). */
+	FleetParams placement;
 	/** Merged map cell size in metres; 0 = the world robot's. */
 	double output_resolution = 0;
 	/** Placements from the given initial poses only (m-explore's known_init_poses). */

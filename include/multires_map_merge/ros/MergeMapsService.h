@@ -55,6 +55,8 @@ class MergeMapsService
 	/** The largest merged map returned, in cells (int8 each); above it the
 	 * request is refused with a message suggesting a coarser output. */
 	size_t max_merged_cells = size_t(1) << 26;
+	/** How merge_fleet places its maps (FleetMerge.h). */
+	FleetParams fleet_params;
 
    private:
 	CScalingGridMapAligner::TConfigParams params_;

@@ -1,0 +1,65 @@
+// The fleet's parameters: one list (key, member, range, meaning) that
+// loading, saving, validation, the ROS nodes and README's table all read.
+#include <multires_map_merge/FleetMerge.h>
+
+#include "ParamText.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace multires_map_merge
+{
+using F = FleetParams;
+using namespace param_text;
+
+const std::vector<FleetParamField>& fleetParamFields()
+{
+	constexpr bool zero_default = true, no0 = false;
+	static const std::vector<FleetParamField> fields{
+		{"fleet_threads", &F::threads, 1, 256, zero_default,
+		 "Pairs of a fleet aligned at once (0: one per hardware thread)"},
+		{"settled_confidence", &F::settled_confidence, 0, 1, no0,
+		 "A map placed this surely takes no more pairs; the rest are skipped"},
+		{"unsettled_tries", &F::unsettled_tries, 0, 1000, no0,
+		 "A placed map less sure than that tries this many more pairs for a surer path"},
+		{"cycle_tolerance_cells", &F::cycle_tolerance_cells, 0.1, 1e4, no0,
+		 "Least tolerance of a cycle of pairs before its weakest pair is dropped [coarse cells]"},
+		{"cycle_tolerance_per_rmse", &F::cycle_tolerance_per_rmse, 0, 1e3, no0,
+		 "A pair's tolerance: this many times its edge RMSE, within the least and the largest"},
+		{"cycle_tolerance_max_cells", &F::cycle_tolerance_max_cells, 0.1, 1e4, zero_default,
+		 "Largest tolerance (0: the aligner's distinct_shift) [coarse cells]"},
+		{"joint_refinement", &F::joint_refinement, 0, 1, no0,
+		 "Refine every placement at once from all confident pairs kept (false: each through its one path)"},
+	};
+	return fields;
+}
+
+void F::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	for (const auto& f : fleetParamFields()) readField(*this, f.member, c, s, f.key);
+	if (const std::string why = invalidReason(); !why.empty()) throw std::invalid_argument("[" + s + "] " + why);
+}
+
+void F::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	for (const auto& f : fleetParamFields()) writeKey(c, s, f.key, valueText(*this, f.member), f.description);
+}
+
+std::string F::invalidReason() const
+{
+	for (const auto& f : fleetParamFields())
+		if (std::string why = outOfRange(*this, f.member, f.key, f.lo, f.hi, f.zero_is_default); !why.empty()) return why;
+	return "";
+}
+
+std::string fleetParamsMarkdown()
+{
+	const F defaults;
+	std::ostringstream md;
+	md << "| key | default | valid | meaning |\n|---|---|---|---|\n";
+	for (const auto& f : fleetParamFields())
+		md << markdownRow(defaults, f.member, f.key, f.lo, f.hi, f.zero_is_default, f.description);
+	return md.str();
+}
+
+}  // namespace multires_map_merge
