@@ -85,10 +85,13 @@ std::vector<std::string> alignerParamKeys()
 
 void P::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	for (const auto& f : alignerParamFields()) readField(*this, f.member, c, s, f.key);
-	for (const auto& f : decisionParamFields()) decision.*f.member = c.read_double(s, f.key, decision.*f.member);
-	if (const std::string why = invalidReason(); !why.empty())
-		throw std::invalid_argument("[" + s + "] " + why);
+	// Into a copy: a value refused leaves these parameters as they were.
+	P read = *this;
+	for (const auto& f : alignerParamFields()) readField(read, f.member, c, s, f.key);
+	for (const auto& f : decisionParamFields())
+		read.decision.*f.member = c.read_double(s, f.key, read.decision.*f.member);
+	if (const std::string why = read.invalidReason(); !why.empty()) throw std::invalid_argument("[" + s + "] " + why);
+	*this = read;
 }
 
 void P::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const

@@ -30,6 +30,13 @@ double FleetParams::toleranceOf(const FleetEdge& e) const
 		std::max(cycle_tolerance_cells, maxToleranceCells()));
 }
 
+FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
+{
+	FleetParams p = *this;
+	if (!(p.cycle_tolerance_max_cells > 0)) p.cycle_tolerance_max_cells = decision.distinct_shift;
+	return p;
+}
+
 double FleetParams::maxToleranceCells() const
 {
 	return cycle_tolerance_max_cells > 0 ? cycle_tolerance_max_cells : DecisionParams{}.distinct_shift;
@@ -441,8 +448,7 @@ FleetResult placeFleet(
 	if (const std::string why = given_params.invalidReason(); !why.empty())
 		throw std::invalid_argument("invalid fleet parameters: " + why);
 	// Two placements the aligner's decision tells apart are never one.
-	FleetParams params = given_params;
-	if (!(params.cycle_tolerance_max_cells > 0)) params.cycle_tolerance_max_cells = aligner.options.decision.distinct_shift;
+	const FleetParams params = given_params.resolvedFor(aligner.options.decision);
 	if (maps.size() < 2) throw std::invalid_argument("a fleet merge needs at least two maps");
 	if (reference >= maps.size()) throw std::invalid_argument("reference index out of range");
 	const size_t n = maps.size();

@@ -36,8 +36,11 @@ const std::vector<FleetParamField>& fleetParamFields()
 
 void F::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	for (const auto& f : fleetParamFields()) readField(*this, f.member, c, s, f.key);
-	if (const std::string why = invalidReason(); !why.empty()) throw std::invalid_argument("[" + s + "] " + why);
+	// Into a copy: a value refused leaves these parameters as they were.
+	F read = *this;
+	for (const auto& f : fleetParamFields()) readField(read, f.member, c, s, f.key);
+	if (const std::string why = read.invalidReason(); !why.empty()) throw std::invalid_argument("[" + s + "] " + why);
+	*this = read;
 }
 
 void F::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const

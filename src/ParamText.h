@@ -55,8 +55,9 @@ bool isBool(const Member& member)
 }
 
 /** Reads `key` of section `s` into the field (absent: unchanged). An
- * unsigned count is read as a number, so a negative or fractional one is
- * refused by name instead of wrapping around. */
+ * unsigned count is read as text and parsed whole, so a negative,
+ * fractional, too large or non-numeric one is refused by name instead of
+ * wrapping around (or reading as 0, as atof would). */
 template <class Params, class Member>
 void readField(Params& params, const Member& member, const mrpt::config::CConfigFileBase& c, const std::string& s,
 	const char* key)
@@ -70,10 +71,22 @@ void readField(Params& params, const Member& member, const mrpt::config::CConfig
 			else if constexpr (std::is_floating_point_v<T>) v = c.read_double(s, key, v);
 			else
 			{
-				const double read = c.read_double(s, key, double(v));
-				if (!(read >= 0 && read <= double(std::numeric_limits<T>::max())) || read != std::floor(read))
+				const std::string text = c.read_string(s, key, "", false);
+				if (text.empty()) return;
+				double read = NAN;
+				size_t used = 0;
+				try
+				{
+					read = std::stod(text, &used);
+				}
+				catch (const std::exception&)
+				{
+				}
+				const bool whole = used == text.size() && read >= 0 && read == std::floor(read) &&
+					read < std::ldexp(1.0, std::numeric_limits<T>::digits);
+				if (!whole)
 					throw std::invalid_argument(
-						"[" + s + "] " + key + " = " + exactText(read) + " is not a count (a whole number >= 0)");
+						"[" + s + "] " + key + " = " + text + " is not a count (a whole number >= 0)");
 				v = static_cast<T>(read);
 			}
 		},

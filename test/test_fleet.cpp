@@ -208,7 +208,29 @@ TEST(Fleet, RefusesTooFewMapsAndABadReference)
 	EXPECT_THROW(placeFleet(two, 2, CScalingGridMapAligner()), std::invalid_argument);
 	FleetParams bad;
 	bad.settled_confidence = std::nan("");
-	EXPECT_THROW(placeFleet(two, 0, CScalingGridMapAligner(), bad), std::invalid_argument);
+	try
+	{
+		placeFleet(two, 0, CScalingGridMapAligner(), bad);
+		ADD_FAILURE() << "a NaN settled_confidence was taken";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("settled_confidence"), std::string::npos) << e.what();
+	}
+}
+
+// Placements the aligner's decision tells apart are never one: the largest
+// cycle tolerance follows its distinct_shift unless set.
+TEST(Fleet, TheLargestToleranceFollowsTheDecisionsDistinctShift)
+{
+	DecisionParams decision;
+	decision.distinct_shift = 25;
+	FleetEdge loose;
+	loose.rmse_coarse_cells = 100;
+	EXPECT_DOUBLE_EQ(FleetParams().resolvedFor(decision).toleranceOf(loose), 25);
+	FleetParams set;
+	set.cycle_tolerance_max_cells = 30;
+	EXPECT_DOUBLE_EQ(set.resolvedFor(decision).toleranceOf(loose), 30);
 }
 
 // Every fleet key is written and reads back; a bad value is refused naming
@@ -233,7 +255,8 @@ TEST(Fleet, ParametersReadBackFromAnIniAndBadOnesAreNamed)
 	EXPECT_EQ(read.cycle_tolerance_max_cells, 25);
 	EXPECT_FALSE(read.joint_refinement);
 	for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-			 {"unsettled_tries", "-1"}, {"fleet_threads", "1.5"}, {"settled_confidence", "2"},
+			 {"unsettled_tries", "-1"}, {"unsettled_tries", "two"}, {"unsettled_tries", "1e30"},
+			 {"fleet_threads", "1.5"}, {"settled_confidence", "2"},
 			 {"cycle_tolerance_cells", "0"}, {"cycle_tolerance_max_cells", "-3"}})
 	{
 		mrpt::config::CConfigFileMemory bad;
@@ -248,6 +271,13 @@ TEST(Fleet, ParametersReadBackFromAnIniAndBadOnesAreNamed)
 			EXPECT_NE(std::string(e.what()).find("[fleet] " + key), std::string::npos) << e.what();
 		}
 	}
+	// A refused file leaves the parameters as they were.
+	mrpt::config::CConfigFileMemory half;
+	half.write("fleet", "joint_refinement", "false");
+	half.write("fleet", "settled_confidence", "7");
+	FleetParams kept;
+	EXPECT_THROW(kept.loadFromConfigFile(half, "fleet"), std::invalid_argument);
+	EXPECT_TRUE(kept.joint_refinement);
 }
 
 namespace

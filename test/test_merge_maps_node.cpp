@@ -3,6 +3,7 @@
 // input without dying, and takes its parameters from an ini file and the
 // parameter server.
 #include <multires_map_merge/ros/AlignerParamsFromRos.h>
+#include <multires_map_merge/ros/MapMergeNode.h>
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -104,6 +105,10 @@ TEST(MergeMapsNode, FleetParametersFromTheIniFileAndTheServer)
 	EXPECT_FALSE(p.joint_refinement);
 	EXPECT_EQ(p.unsettled_tries, 7u);  // the server's, over the ini's 5
 	EXPECT_EQ(p.cycle_tolerance_cells, FleetParams().cycle_tolerance_cells);  // the default
+	// The live map_merge node places its robots with them.
+	const ros1::MapMergeConfig live = ros1::MapMergeConfig::fromParams(ros::NodeHandle(ns));
+	EXPECT_EQ(live.fleet.placement.unsettled_tries, 7u);
+	EXPECT_FALSE(live.fleet.placement.joint_refinement);
 	ros::param::set(ns + "/settled_confidence", 1.5);
 	try
 	{

@@ -67,7 +67,7 @@ struct FleetParams
 	double settled_confidence = 0.95;
 	/** A placed map not yet settled tries this many more pairs, most
 	 * promising first, for a surer path. */
-	size_t unsettled_tries = 2;
+	unsigned unsettled_tries = 2;
 	/** A cycle whose composed transform moves the corners of what a map saw
 	 * by more than its tolerance (cells of the coarser map, RMS) is
 	 * contradictory. A pair's tolerance follows its precision:
@@ -87,6 +87,9 @@ struct FleetParams
 	double toleranceOf(const FleetEdge& e) const;
 	/** The largest tolerance: cycle_tolerance_max_cells, or its default. */
 	double maxToleranceCells() const;
+	/** These parameters with cycle_tolerance_max_cells 0 set to the
+	 * decision's distinct_shift (what placeFleet places with). */
+	FleetParams resolvedFor(const DecisionParams& decision) const;
 	/** The tree's placements refined at once from every confident pair kept
 	 * (JointPlacement.h): a map reached through a chain is then placed by
 	 * every pair that sees it, not by one path. */
@@ -109,7 +112,7 @@ struct FleetParams
 struct FleetParamField
 {
 	const char* key;
-	std::variant<double FleetParams::*, unsigned FleetParams::*, size_t FleetParams::*, bool FleetParams::*> member;
+	std::variant<double FleetParams::*, unsigned FleetParams::*, bool FleetParams::*> member;
 	double lo, hi;
 	bool zero_is_default;
 	const char* description;

@@ -269,7 +269,8 @@ bool LiveFleet::moveWorldIfAlone(const Snapshot& s, size_t& world, FleetResult& 
 	const int better = largestGroupMember(s.maps.size(), result.edges);
 	if (better < 0 || size_t(better) == world) return false;
 	world = size_t(better);
-	result = placeFromPairs(s.maps, world, result.edges);  // on the pairs aligned so far
+	// On the pairs aligned so far, placed as placeFleet places them.
+	result = placeFromPairs(s.maps, world, result.edges, params_.placement.resolvedFor(params_.aligner.decision));
 	return true;
 }
 
