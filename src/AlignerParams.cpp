@@ -118,7 +118,7 @@ std::string alignerParamsMarkdown()
 		if (std::string(f.key) == "min_confidence")
 			md << "| `" << f.key << "` | " << exactText(defaults.decision.*f.member) << " | "
 			   << rangeText(f.lo, f.hi, false) << " | " << f.comment << " |\n";
-	md << "| `decision_*`, `distinct_shift` | calibrated | | the decision's score, gates, rivals and threshold "
+	md << "| `decision_*`, `distinct_shift` | calibrated | | the decision's score, rivals and threshold "
 		  "([docs/decision.md](docs/decision.md#parameters)) |\n";
 	return md.str();
 }

@@ -32,20 +32,15 @@ bool samePlacement(const Placement& a, const Placement& b, double cells, double 
 		std::abs(std::log(a.cells.scale / b.cells.scale)) <= log_scale;
 }
 
-const std::array<DecisionParamField, 12>& decisionParamFields()
+const std::array<DecisionParamField, 9>& decisionParamFields()
 {
 	using P = DecisionParams;
-	static const std::array<DecisionParamField, 12> fields{{
+	static const std::array<DecisionParamField, 9> fields{{
 		{"decision_chance_weight", &P::chance_weight, 0, 10,
 		 "Score = B + w (B - chance T) - sqrt(evidence / judged) + feature term"},
 		{"decision_evidence", &P::evidence, 0, 1e6, "Evidence discount of small overlaps [wall points]"},
 		{"decision_feature_weight", &P::feature_weight, 0, 10, "Score gained at decision_feature_cap agreeing feature matches"},
 		{"decision_feature_cap", &P::feature_cap, 1, 1e6, "Agreeing feature matches beyond this gain no more"},
-		{"decision_min_lead", &P::min_lead, -1, 1, "Merged on its walls only if they agree more than chance by this"},
-		{"decision_min_wall_alignment", &P::min_wall_alignment, 0, 1,
-		 "Merged on its walls only if this share of near walls run alike"},
-		{"decision_min_shift_coherence", &P::min_shift_coherence, 0, 1,
-		 "Merged on its walls only if this share of adjacent regions fit after alike shifts"},
 		{"decision_runner_up_weight", &P::runner_up_weight, 0, 100,
 		 "Decision value = best score + w (it - best distinct rival's score)"},
 		{"decision_runner_up_floor", &P::runner_up_floor, -10, 10, "A rival scoring below this counts as this"},
@@ -73,20 +68,6 @@ double DecisionParams::score(const Evidence& e) const
 	const double b = e.bent_consistency;
 	return b + chance_weight * (b - e.chance_consistency) - std::sqrt(evidence / std::max(1.0, e.judged_points)) +
 		feature_weight * std::min(e.feature_agreement, feature_cap) / feature_cap;
-}
-
-bool DecisionParams::leadsChance(const Evidence& e) const
-{
-	return e.bent_consistency - e.chance_consistency >= min_lead;
-}
-
-bool DecisionParams::wallsRunAlike(const Evidence& e) const { return e.wall_alignment >= min_wall_alignment; }
-
-bool DecisionParams::shiftsCohere(const Evidence& e) const { return e.shift_coherence >= min_shift_coherence; }
-
-bool DecisionParams::mayMergeOnWalls(const Evidence& e) const
-{
-	return leadsChance(e) && wallsRunAlike(e) && shiftsCohere(e);
 }
 
 bool DecisionParams::areRivals(const Placement& a, const Placement& b) const
@@ -128,7 +109,7 @@ bool DecisionParams::mergedWhateverComes(const DecisionCandidate& c, double exac
 	const Evidence& e = c.evidence;
 	if (e.exact_confidence >= exact_needed) return true;
 	const double s = score(e);
-	return !c.screened && e.judged_points >= min_judged_points && s >= runner_up_floor && mayMergeOnWalls(e) &&
+	return !c.screened && e.judged_points >= min_judged_points && s >= runner_up_floor &&
 		confidenceOfValue(s) >= std::max(0.5, min_confidence);
 }
 
@@ -166,8 +147,7 @@ Decision decide(const std::vector<DecisionCandidate>& cands, const DecisionParam
 				(cands[i].mirrored || p.areRivals(cands[b].placement, cands[i].placement)))
 				d.runner_up_score = std::max(d.runner_up_score, d.scores[i]);
 		d.value = d.scores[b] + p.runner_up_weight * (d.scores[b] - d.runner_up_score);
-		if (p.mayMergeOnWalls(cands[b].evidence))
-			d.confidence[b] = std::max(d.confidence[b], p.confidenceOfValue(d.value));
+		d.confidence[b] = std::max(d.confidence[b], p.confidenceOfValue(d.value));
 	}
 	// At equal confidence (none at all, typically) the candidate decided on is
 	// reported: a refusal then says why that one was not enough.
@@ -188,18 +168,10 @@ std::string refusalReasons(const Evidence& e, const Decision& d, const DecisionP
 	why << "confidence " << (d.chosen ? d.confidence[*d.chosen] : 0.0) << " < " << p.min_confidence
 		<< "; tolerant consistency " << e.tolerant_consistency << ", " << e.bent_consistency
 		<< " with its bends taken out, against " << e.chance_consistency << " by chance";
-	// The gates and the value speak only of the candidate decided on.
+	// The value speaks only of the candidate decided on.
 	if (!d.chosen || d.chosen != d.best || !std::isfinite(d.value)) return why.str();
 	why << ", score " << d.scores[*d.best] << " against " << d.runner_up_score << " for the best rival (decision value "
 		<< d.value << ", " << p.threshold << " needed)";
-	if (!p.leadsChance(e))
-		why << ", walls agreeing no more than chance (less than decision_min_lead = " << p.min_lead << " above it)";
-	if (!p.wallsRunAlike(e))
-		why << ", walls near the other map's running alike in only " << e.wall_alignment
-			<< " of the cases (decision_min_wall_alignment = " << p.min_wall_alignment << ")";
-	if (!p.shiftsCohere(e))
-		why << ", its regions fitting best after shifts alike in only " << e.shift_coherence
-			<< " of adjacent ones (decision_min_shift_coherence = " << p.min_shift_coherence << ")";
 	return why.str();
 }
 

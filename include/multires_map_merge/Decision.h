@@ -92,11 +92,6 @@ struct DecisionParams
 	double evidence = 400;  //!< evidence discount [wall points]
 	double feature_weight = 0.2;
 	double feature_cap = 10;
-	/** Gates on merging by the walls: B − C ≥ min_lead, A ≥ min_wall_alignment,
-	 * H ≥ min_shift_coherence. */
-	double min_lead = 0.04;
-	double min_wall_alignment = 0.7;
-	double min_shift_coherence = 0.25;
 	/** value = score + runner_up_weight (score − max(runner_up_floor, best rival's score)) */
 	double runner_up_weight = 1.0;
 	double runner_up_floor = 0.25;
@@ -107,7 +102,7 @@ struct DecisionParams
 	 * on Halmstad; at most 2 m at 5 cm cells, what the benchmark calls right. */
 	double distinct_shift = 40.0;
 	/** The decision value at confidence 0.5; ±0.1 (1 + runner_up_weight) spans 0..1. */
-	double threshold = 0.664;
+	double threshold = 0.691;
 	double min_confidence = 0.5;  //!< below it: not merged
 
 	/** Turned by more than this, a candidate is a rival (the far
@@ -122,11 +117,6 @@ struct DecisionParams
 	std::string invalidReason() const;
 
 	double score(const Evidence& e) const;
-	bool leadsChance(const Evidence& e) const;
-	bool wallsRunAlike(const Evidence& e) const;
-	bool shiftsCohere(const Evidence& e) const;
-	/** The candidate's walls may decide a merge: all three gates pass. */
-	bool mayMergeOnWalls(const Evidence& e) const;
 	bool areRivals(const Placement& a, const Placement& b) const;
 	/** Decision value per unit of confidence: 0.2 (1 + runner_up_weight). */
 	double valuePerConfidence() const;
@@ -155,7 +145,7 @@ struct DecisionParamField
 	double lo, hi;
 	const char* comment;
 };
-const std::array<DecisionParamField, 12>& decisionParamFields();
+const std::array<DecisionParamField, 9>& decisionParamFields();
 
 /** The pair's decision. */
 struct Decision
@@ -178,7 +168,7 @@ struct Decision
 Decision decide(const std::vector<DecisionCandidate>& candidates, const DecisionParams& p);
 
 /** Why the decision on the chosen candidate (its evidence) was not to merge:
- * the value against the threshold and every gate it failed, comma-separated. */
+ * its evidence, and the value against the threshold. */
 std::string refusalReasons(const Evidence& chosen, const Decision& d, const DecisionParams& p);
 
 }  // namespace multires_map_merge
