@@ -110,7 +110,7 @@ void runCoarserCalibrationPairs(const BenchContext& ctx, const HalmstadData& dat
 		std::ostringstream other_name;
 		other_name << run.other << "_x" << run.factor;
 		writeCandidates(ctx, run.site, run.ref, other_name.str(), true, true, r, error_of, [&](const auto& c) {
-			return finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells, o.finishParams(), o.decision);
+			return finishBent(*ref_prepared, *other_prepared, c.cells, c.evidence.exact_confidence, o.finishParams(), o.decision);
 		});
 	};
 	runCoarserOther(data, {"E5", "HIH"}, kCoarserFactors, ctx.options, dir, sink);

@@ -51,7 +51,7 @@ HalmstadRun runHalmstadPair(
 	writeCandidates(ctx, run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
 		const auto& o = ctx.options;
 		return ref_prepared
-			? finishBent(*ref_prepared, *other_prepared, c.cells, c.rmse_coarse_cells, o.finishParams(), o.decision)
+			? finishBent(*ref_prepared, *other_prepared, c.cells, c.evidence.exact_confidence, o.finishParams(), o.decision)
 			: c.cells;
 	});
 	std::cout << "halmstad " << ref << " <- " << other << ": "

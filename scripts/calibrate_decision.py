@@ -134,10 +134,11 @@ def load(paths):
 
 def not_fitted(row):
     """Pairs the calibration data holds but the fit leaves out (docs/decision.md,
-    Calibration): OTHER recorded coarser (`other` E5_05_x2), whose highest
-    wrong best candidate is an imprecise placement of the right place (48 px
-    off the annotation, 13 px from a right candidate): a matter for the
-    finish, not the decision. The benchmark reports them."""
+    Calibration): OTHER recorded coarser (`other` E5_05_x2). Their highest
+    wrong best candidate (E5_11 <- E5_05 x2, 0.702) has the evidence of the
+    weakest right merges; fitting it moves the grid to a threshold that
+    refuses a seventh of E5's sensor pairs and most of its floor plans.
+    The benchmark reports them."""
     return "_x" in row["other"]
 
 

@@ -55,7 +55,7 @@ const std::vector<AlignerParamField>& alignerParamFields()
 		 "Refits of each refined candidate to its wall tiles' best shifts before it is judged (0: off)"},
 		// Finish (Finish.h)
 		{"icp_finish_on_occupied", &P::icp_finish_on_occupied, 0, 1, no0,
-		 "Finish the decided transform by TsICP on the overlap's occupied cells (edges within 1.5 coarse cells)"},
+		 "Finish the decided transform by TsICP on the overlap's occupied cells (maps whose cells coincide)"},
 		{"finish_max_shift", &P::finish_max_shift, 0, 100, no0, "A finish moving a wall further is not taken [coarse cells]"},
 		{"finish_lattice_step", &P::finish_lattice_step, 0.01, 0.5, off0,
 		 "Step of the finish's sub-cell shift of the finer map on the coarser lattice (0: off) [coarse cells]"},

@@ -237,7 +237,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// 6. The decided transform finished (Finish.h).
 	stage.Tic();
 	const Finished finished = finishDecided(
-		ref, other, info.cells, info.trimmed_rmse_coarse_cells, d.merged, options.finishParams(), decision);
+		ref, other, info.cells, info.evidence.exact_confidence, d.merged, options.finishParams(), decision);
 	if (finished.ran)
 	{
 		info.cells = finished.cells;

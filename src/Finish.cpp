@@ -79,11 +79,11 @@ namespace
 {
 /** finishBent's refit, or none where it does not apply or is not taken. */
 std::optional<Similarity2D> bentRefit(
-	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells,
+	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double exact_confidence,
 	const FinishParams& p, const DecisionParams& decision)
 {
-	// Maps whose edges may coincide are the exact finish's (finishOnOccupied).
-	if (p.bent_lambda <= 0 || !(rmse_coarse_cells >= kExactMaxRmse) || other.edges.empty() || !ref.edge_tree ||
+	// Maps that coincide are the exact finish's (finishOnOccupied).
+	if (p.bent_lambda <= 0 || cellsCoincide(exact_confidence) || other.edges.empty() || !ref.edge_tree ||
 		!other.edge_tree)
 		return std::nullopt;
 	TsICPParams wide = p.icp;
@@ -100,19 +100,20 @@ std::optional<Similarity2D> bentRefit(
 }  // namespace
 
 Similarity2D finishBent(
-	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells,
+	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double exact_confidence,
 	const FinishParams& p, const DecisionParams& decision)
 {
-	return bentRefit(ref, other, cells, rmse_coarse_cells, p, decision).value_or(cells);
+	return bentRefit(ref, other, cells, exact_confidence, p, decision).value_or(cells);
 }
 
 Finished finishDecided(
-	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double rmse_coarse_cells,
+	const PreparedMap& ref, const PreparedMap& other, const Similarity2D& cells, double exact_confidence,
 	bool confident, const FinishParams& p, const DecisionParams& decision)
 {
 	Finished out;
 	out.cells = cells;
-	if (p.on_occupied && confident && rmse_coarse_cells < kExactMaxRmse)
+	const bool coincide = cellsCoincide(exact_confidence);
+	if (p.on_occupied && confident && coincide)
 	{
 		out.ran = true;
 		const Similarity2D finished = finishOnOccupied(ref, other, cells, p.icp, p.lattice);
@@ -127,10 +128,10 @@ Finished finishDecided(
 			out.note = why.str();
 		}
 	}
-	else if (p.bent_lambda > 0 && rmse_coarse_cells >= kExactMaxRmse)
+	else if (p.bent_lambda > 0 && !coincide)
 	{
 		out.ran = true;
-		if (auto refit = bentRefit(ref, other, cells, rmse_coarse_cells, p, decision))
+		if (auto refit = bentRefit(ref, other, cells, exact_confidence, p, decision))
 			out.cells = *refit;
 		else
 			out.note = "refit over the whole overlap not taken: it places the other map elsewhere";

@@ -104,6 +104,34 @@ TEST(RealMaps, HalmstadBentMapsArePlacedOverTheWholeOverlap)
 	EXPECT_GT(a.stage_seconds.count("finish"), 0u);
 }
 
+
+TEST(RealMaps, HalmstadCoarseRecordingOfABentMapIsRefitToo)
+{
+	REQUIRE_HALMSTAD();
+	// E5_08 recorded with cells 3.3× larger (stated 0.05 m, wrong) against
+	// E5_12: its edges fit within 1.5 of its large cells, yet the maps bend
+	// by many fine cells. What tells the finish which maps coincide is the
+	// cell agreement (Finish.h cellsCoincide), not that RMSE: the occupied-
+	// cell finish kept the trimmed fit's one region, 48 px off the annotation.
+	const double factor = 3.3;
+	const GridInFrame r = loadGridMap(halmstad()->yaml("E5_12", dir()));
+	const GridInFrame fine = loadGridMap(halmstad()->yaml("E5_08", dir()));
+	const GridInFrame coarse = loadGridMap(multires_bench::coarserYaml(*halmstad(), "E5_08", factor, dir()));
+	const auto* truth = halmstad()->pair("E5_08", "E5_12");
+	ASSERT_NE(truth, nullptr);
+	CScalingGridMapAligner with, without;
+	without.options.finish_bent_lambda = 0;
+	const auto a = with.alignScaled(r, coarse), b = without.alignScaled(r, coarse);
+	ASSERT_TRUE(a.success) << a.message;
+	EXPECT_EQ(a.evidence.exact_confidence, 0.0) << "the cells do not coincide";
+	const Similarity2D fine_in_coarse =
+		multires_bench::fineToCoarse(factor, int(fine.grid.getSizeY()), int(coarse.grid.getSizeY()));
+	const int rows = static_cast<int>(r.grid.getSizeY());
+	const auto judged_with = multires_bench::judge(a.metric.compose(fine_in_coarse), *truth, fine, rows);
+	const auto judged_without = multires_bench::judge(b.metric.compose(fine_in_coarse), *truth, fine, rows);
+	EXPECT_TRUE(judged_with.right) << judged_with.mean_displacement_px << " px";
+	EXPECT_LT(judged_with.mean_displacement_px, judged_without.mean_displacement_px - 10);
+}
 TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 {
 	REQUIRE_HALMSTAD();
