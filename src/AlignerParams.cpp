@@ -1,5 +1,5 @@
 // The aligner's parameters: one list (key, member, range, meaning) that
-// loading, saving, validation, the ROS keys and README's table all read.
+// loading, saving, validation, the ROS keys and docs/parameters.md's table all read.
 #include <multires_map_merge/CScalingGridMapAligner.h>
 
 #include "ParamText.h"
@@ -119,7 +119,7 @@ std::string alignerParamsMarkdown()
 			md << "| `" << f.key << "` | " << exactText(defaults.decision.*f.member) << " | "
 			   << rangeText(f.lo, f.hi, false) << " | " << f.comment << " |\n";
 	md << "| `decision_*`, `distinct_shift` | calibrated | | the decision's score, rivals and threshold "
-		  "([docs/decision.md](docs/decision.md#parameters)) |\n";
+		  "([decision.md](decision.md#parameters)) |\n";
 	return md.str();
 }
 

@@ -1,5 +1,5 @@
 // The fleet's parameters: one list (key, member, range, meaning) that
-// loading, saving, validation, the ROS nodes and README's table all read.
+// loading, saving, validation, the ROS nodes and docs/parameters.md's table all read.
 #include <multires_map_merge/FleetMerge.h>
 
 #include "ParamText.h"

@@ -1,7 +1,7 @@
 #pragma once
 // How a parameter of a field list (key, member, range, meaning) is read,
 // checked and written: in an ini file (a value that reads back exactly, its
-// meaning beside it) and in README's tables (its valid range). The aligner's
+// meaning beside it) and in docs/parameters.md's tables (its valid range). The aligner's
 // and the fleet's parameter lists both go through these.
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/core/format.h>
@@ -103,7 +103,7 @@ std::string outOfRange(const Params& params, const Member& member, const char* k
 	return mrpt::format("%s = %g is outside %s", key, v, rangeText(lo, hi, zero_also).c_str());
 }
 
-/** README's table row of a field. */
+/** The docs/parameters.md table row of a field. */
 template <class Params, class Member>
 std::string markdownRow(const Params& defaults, const Member& member, const char* key, double lo, double hi,
 	bool zero_also, const char* description)

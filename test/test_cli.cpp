@@ -199,14 +199,14 @@ TEST(Cli, UnwritableOutputsExitTwoBeforeAnyWork)
 	EXPECT_FALSE(fs::exists(d + "/x.png"));
 }
 
-// README's parameter table is the one list as gridmap-merge prints it, and
+// docs/parameters.md's tables are the one list as gridmap-merge prints it, and
 // --write-config writes every key, which loads back as the defaults.
 TEST(Cli, ParametersAsReadmeListsThemAndWrittenAsAnIni)
 {
 	const CliRun table = runCli("--parameters");
 	ASSERT_EQ(table.exit_code, 0) << table.output;
-	EXPECT_NE(slurp(MMM_README).find(table.output), std::string::npos)
-		<< "README.md's parameter table differs from `gridmap-merge --parameters`; paste it:\n" << table.output;
+	EXPECT_NE(slurp(MMM_PARAMETERS_DOC).find(table.output), std::string::npos)
+		<< "docs/parameters.md's tables differ from `gridmap-merge --parameters`; paste them:\n" << table.output;
 
 	const std::string ini = dir() + "/written.ini";
 	const CliRun written = runCli("--write-config " + ini);

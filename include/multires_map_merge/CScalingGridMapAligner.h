@@ -313,7 +313,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 /** One aligner parameter: its ini key (section [aligner]; the ROS parameter of
  * the same name), its member, its valid range (0 also valid where it turns the
  * step off) and what it sets. Loading, saving, validation, the ROS nodes' keys
- * and README's table (gridmap-merge --parameters) all read this one list; the
+ * and docs/parameters.md (gridmap-merge --parameters) all read this one list; the
  * decision's parameters are decisionParamFields(). */
 struct AlignerParamField
 {
@@ -329,7 +329,7 @@ const std::vector<AlignerParamField>& alignerParamFields();
 /** Every ini key, the aligner's and then the decision's, in the saved order. */
 std::vector<std::string> alignerParamKeys();
 
-/** README's parameter table: key, default, valid range, description. */
+/** The aligner parameter table (docs/parameters.md): key, default, valid range, description. */
 std::string alignerParamsMarkdown();
 
 }  // namespace multires_map_merge

@@ -108,7 +108,7 @@ struct FleetParams
 /** One fleet parameter: its ini key (section [fleet]; the ROS parameter of
  * the same name), its member, its valid range (0 also valid where it turns
  * the setting to its default) and what it sets. Loading, saving,
- * validation, the ROS nodes and README's table read this one list. */
+ * validation, the ROS nodes and docs/parameters.md read this one list. */
 struct FleetParamField
 {
 	const char* key;
@@ -118,7 +118,7 @@ struct FleetParamField
 	const char* description;
 };
 const std::vector<FleetParamField>& fleetParamFields();
-/** README's fleet parameter table: key, default, valid range, description. */
+/** The fleet parameter table (docs/parameters.md): key, default, valid range, description. */
 std::string fleetParamsMarkdown();
 
 /** What a caller that places the same fleet again and again (LiveFleet, as

@@ -195,7 +195,7 @@ Request parseCommandLine(int argc, char** argv)
 		false,
 		"", "FILE.ini", cmd);
 	TCLAP::SwitchArg parameters_arg(
-		"", "parameters", "print every aligner and fleet parameter: key, default, valid range, meaning (README's tables)",
+		"", "parameters", "print every aligner and fleet parameter: key, default, valid range, meaning (docs/parameters.md)",
 		cmd);
 	TCLAP::SwitchArg metadata_arg(
 		"", "use-resolution-metadata", "use the stated resolutions as a scale prior", cmd);
