@@ -23,6 +23,11 @@ struct HalmstadRun
 	std::string message;
 	LimitedMrpt mrpt;
 	bool mrpt_right = false;
+	/** A positive not merged right is aligned again with the annotation as
+	 * the first hypothesis (then the usual search and decision): merged right
+	 * then, the search missed it; refused again, its evidence is too weak. */
+	bool retried_from_truth = false;
+	bool right_from_truth = false;
 };
 
 /** Aligns REF ← OTHER from map_server files; for positives judges the result

@@ -71,14 +71,18 @@ int floorPlansOnly(const BenchContext& ctx, const std::string& sites)
 int halmstadOnly(const BenchContext& ctx, const std::string& sites, size_t negatives_per_map)
 {
 	const auto runs = runHalmstad(ctx, HalmstadData(ctx.data + "/halmstad"), siteList(sites), negatives_per_map);
-	size_t right = 0, wrong = 0, pos = 0, false_merges = 0;
+	size_t right = 0, wrong = 0, pos = 0, false_merges = 0, search_missed = 0, evidence_weak = 0;
 	for (const auto& r : runs)
 		if (r.positive)
+		{
 			++pos, right += r.merged && r.outcome.right, wrong += r.merged && !r.outcome.right;
+			if (r.retried_from_truth) ++(r.right_from_truth ? search_missed : evidence_weak);
+		}
 		else
 			false_merges += r.merged;
 	std::cout << "halmstad: " << right << "/" << pos << " merged right, " << wrong << " merged wrong, " << false_merges
-			  << "/" << runs.size() - pos << " false merges\n";
+			  << "/" << runs.size() - pos << " false merges; of the others, from the annotation: " << search_missed
+			  << " merged right (the search missed them), " << evidence_weak << " refused (evidence too weak)\n";
 	return 0;
 }
 

@@ -38,6 +38,9 @@ struct SiteRow
 	size_t pairs = 0, right = 0, refused = 0, wrong = 0;
 	std::vector<double> disp, corr, secs;
 	size_t mrpt_ran = 0, mrpt_right = 0, mrpt_timeout = 0;
+	/** Of the pairs not merged right: merged right from the annotation (the
+	 * search missed them), refused from it too (their evidence is too weak). */
+	size_t search_missed = 0, evidence_weak = 0;
 };
 
 /** What more than one section reads (a section's text, a target): computed once. */
@@ -80,6 +83,7 @@ Facts factsOf(const FullRun& run)
 		if (!h.merged) ++row.refused;
 		else if (h.outcome.right) ++row.right, row.disp.push_back(h.outcome.mean_displacement_px), row.corr.push_back(h.outcome.corr_rms_px);
 		else ++row.wrong;
+		if (h.retried_from_truth) ++(h.right_from_truth ? row.search_missed : row.evidence_weak);
 		if (h.mrpt.seconds > 0) ++row.mrpt_ran, row.mrpt_right += h.mrpt_right, row.mrpt_timeout += !h.mrpt.finished;
 	}
 	for (const auto& [site, row] : f.sites)
@@ -370,9 +374,12 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 		  "**right** = reported merged with the mean displacement of OTHER's occupied pixels against the annotated "
 		  "similarity ≤ 40 px *and* the annotated inlier correspondences' RMS ≤ max(2 × the annotation's own "
 		  "`rms_px`, 40 px). E5 and HIH are the calibration sites (the decision was tuned on them, "
-		  "`scripts/calibrate_decision.py`); **F5 and KPT4A are the acceptance set: never tuned on**.\n\n"
-	   << "| site | role | pairs | merged right | refused | merged wrong | median displacement [px] | median corr. RMS [px] | median runtime [s] | MRPT (sample, 30 s limit) |\n"
-	   << "|---|---|---|---|---|---|---|---|---|---|\n";
+		  "`scripts/calibrate_decision.py`); **F5 and KPT4A are the acceptance set: never tuned on**. "
+		  "*Not merged right, from the annotation*: each such pair aligned again with the annotated similarity as "
+		  "its first hypothesis (then the usual search and decision): merged right then, the search missed it; "
+		  "refused again, what its walls say is too weak to merge on.\n\n"
+	   << "| site | role | pairs | merged right | refused | merged wrong | not merged right, from the annotation: merged right (search missed) | refused (evidence too weak) | median displacement [px] | median corr. RMS [px] | median runtime [s] | MRPT (sample, 30 s limit) |\n"
+	   << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 	for (const auto& site : {"E5", "HIH", "F5", "KPT4A"})
 	{
 		if (!f.sites.count(site)) continue;
@@ -380,7 +387,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 		const bool cal = isCalibrationSite(site);
 		md << "| " << site << " | " << (cal ? "calibration" : "**acceptance**") << " | " << r.pairs << " | "
 		   << r.right << " (" << num(100.0 * r.right / std::max<size_t>(1, r.pairs), 0) << " %) | " << r.refused
-		   << " | " << r.wrong << " | " << num(median(r.disp), 1) << " | " << num(median(r.corr), 1) << " | "
+		   << " | " << r.wrong << " | " << r.search_missed << " | " << r.evidence_weak << " | " << num(median(r.disp), 1) << " | " << num(median(r.corr), 1) << " | "
 		   << num(median(r.secs), 2) << " | " << r.mrpt_right << " right of " << r.mrpt_ran << " ("
 		   << r.mrpt_timeout << " timed out) |\n";
 	}
@@ -549,11 +556,11 @@ void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 	const auto &floor_plans = run.floor_plans;
 	const auto& coarser = run.coarser;
 	auto target = [&md](const std::string& what, const std::string& got, bool met) { targetRow(md, what, got, met); };
-	target("Halmstad F5 + KPT4A (acceptance) ≥ 85 % merged right",
+	target("Halmstad F5 + KPT4A (acceptance) ≥ 95 % merged right",
 		   std::to_string(f.acceptance_right) + " / " + std::to_string(f.acceptance_pairs),
-		   f.acceptance_right >= 0.85 * f.acceptance_pairs);
-	target("Halmstad E5 + HIH ≥ 80 % merged right", std::to_string(f.calibration_right) + " / " + std::to_string(f.calibration_pairs),
-		   f.calibration_right >= 0.8 * f.calibration_pairs);
+		   f.acceptance_right >= 0.95 * f.acceptance_pairs);
+	target("Halmstad E5 + HIH ≥ 90 % merged right", std::to_string(f.calibration_right) + " / " + std::to_string(f.calibration_pairs),
+		   f.calibration_right >= 0.9 * f.calibration_pairs);
 	target("0 merged wrong over all Halmstad sensor pairs and cross-site negatives",
 		   std::to_string(f.halmstad_wrong + f.cross_merged), f.halmstad_wrong + f.cross_merged == 0);
 	target("Halmstad runtime per pair no worse than before (median 1.1 s)", num(median(f.halmstad_secs), 2) + " s",
