@@ -22,8 +22,11 @@ HalmstadRun runHalmstadPair(
 	run.site = ref.substr(0, ref.find('_'));
 	run.ref = ref, run.other = other;
 	run.positive = run.site == other.substr(0, other.find('_'));
-	// Calibration data (the issue's): E5 and HIH positives; negatives of an E5 map against another site.
-	run.calibration = run.positive ? isCalibrationSite(run.site) : (ref.rfind("E5_", 0) == 0 || other.rfind("E5_", 0) == 0);
+	// Calibration data (the issue's): E5 and HIH positives, and every
+	// negative with an E5 or HIH map or plan (docs/decision.md, Calibration).
+	const auto site_of = [](const std::string& map) { return map.substr(0, map.find('_')); };
+	run.calibration = run.positive ? isCalibrationSite(run.site)
+								   : isCalibrationSite(site_of(ref)) || isCalibrationSite(site_of(other));
 	const GridInFrame ref_map = loadGridMap(data.yaml(ref, dir)), other_map = loadGridMap(data.yaml(other, dir));
 	const HalmstadPair* truth = run.positive ? data.pair(other, ref) : nullptr;
 	mrpt::system::CTicTac clock;

@@ -140,9 +140,11 @@ OccupancyField occupancyField(const cv::Mat& classes, MapKind kind)
 	else
 	{
 		// What a plan leaves out of its building (grey, transparent) is drawn
-		// as empty: a wall there conflicts. Its white only vouches near walls.
+		// as empty: a wall there, beyond the tolerance from the building,
+		// conflicts (its distance to what is not free is to the building).
+		// Its white only vouches near walls.
 		const cv::Mat outside = classes == kUnknown;
-		cv::distanceTransform(~outside, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+		cv::distanceTransform(outside, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 		f.known = (f.dist_to_occupied <= kPlanVouchesCells) | outside;
 	}
 	const cv::Mat occupied = classes == kOccupied;

@@ -243,6 +243,25 @@ TEST(MapAgreement, WallNormalsOfEachWallCell)
 	EXPECT_EQ(f.wall_normal_deg.at<uint8_t>(30, 20), kNoDirection) << "free space has no wall";
 }
 
+TEST(MapAgreement, AFloorPlanJudgesNearItsWallsAndItsOutsideNotItsRooms)
+{
+	// A plan: one room (walls on the rectangle 20..79), white inside, the
+	// outside left unknown as map_server reads a plan's grey.
+	cv::Mat plan(100, 100, CV_8U, cv::Scalar(kUnknown));
+	plan(cv::Rect(20, 20, 60, 60)).setTo(kOccupied);
+	plan(cv::Rect(21, 21, 58, 58)).setTo(kFree);
+	const OccupancyField f = occupancyField(plan, MapKind::FloorPlan);
+	auto judge = [&](double x, double y) {
+		return tolerantSupport({Eigen::Vector2d(x, y)}, f, Similarity2D(), f, 3.0, false);
+	};
+	const Support on_wall = judge(20, 50), beside = judge(18, 50), furniture = judge(50, 50), outside = judge(10, 50);
+	EXPECT_EQ(on_wall.supported, 1u);
+	EXPECT_EQ(beside.supported, 1u) << "within the tolerance of its wall: a wall drawn thicker";
+	EXPECT_EQ(furniture.judged, 0u) << "the plan's white far from its walls is drawn, not seen";
+	EXPECT_EQ(outside.judged, 1u);
+	EXPECT_EQ(outside.conflicts, 1u) << "a wall where the plan has no building conflicts";
+}
+
 TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 {
 	// At the truth (and with walls bent by two cells) the walls lying near

@@ -102,7 +102,7 @@ struct DecisionParams
 	 * on Halmstad; at most 2 m at 5 cm cells, what the benchmark calls right. */
 	double distinct_shift = 40.0;
 	/** The decision value at confidence 0.5; ±0.1 (1 + runner_up_weight) spans 0..1. */
-	double threshold = 0.691;
+	double threshold = 0.690;
 	double min_confidence = 0.5;  //!< below it: not merged
 
 	/** Turned by more than this, a candidate is a rival (the far
