@@ -32,6 +32,33 @@ std::string asIniValue(const std::string& key, XmlRpc::XmlRpcValue& v)
 			throw std::invalid_argument("parameter ~" + key + " must be a number or a boolean");
 	}
 }
+
+/** `params` loaded from `section` of `source`; a refusal names where the
+ * value came from (`origin`: the ini file, or the node's private
+ * parameters) instead of an ini section the user never wrote. */
+template <class Params>
+void loadNaming(Params& params, const mrpt::config::CConfigFileBase& source, const std::string& section,
+	const std::string& origin)
+{
+	try
+	{
+		params.loadFromConfigFile(source, section);
+	}
+	catch (const std::invalid_argument& e)
+	{
+		std::string why = e.what();
+		const std::string tag = "[" + section + "] ";
+		if (why.rfind(tag, 0) == 0) why.erase(0, tag.size());
+		throw std::invalid_argument(origin + why);
+	}
+}
+
+template <class Params>
+void loadIniFile(const std::string& path, const std::string& section, Params& params)
+{
+	if (!std::filesystem::is_regular_file(path)) throw std::invalid_argument("~config_file '" + path + "': no such file");
+	loadNaming(params, mrpt::config::CConfigFile(path), section, "~config_file '" + path + "' [" + section + "]: ");
+}
 }  // namespace
 
 CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
@@ -40,12 +67,7 @@ CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
 	CScalingGridMapAligner::TConfigParams params;
 	std::string config_file, section = "aligner";
 	pnh.getParam("config_section", section);
-	if (pnh.getParam("config_file", config_file) && !config_file.empty())
-	{
-		if (!std::filesystem::is_regular_file(config_file))
-			throw std::invalid_argument("~config_file '" + config_file + "': no such file");
-		params.loadFromConfigFile(mrpt::config::CConfigFile(config_file), section);
-	}
+	if (pnh.getParam("config_file", config_file) && !config_file.empty()) loadIniFile(config_file, section, params);
 
 	const std::vector<std::string> keys = alignerParamKeys();
 	mrpt::config::CConfigFileMemory overrides;
@@ -54,7 +76,7 @@ CScalingGridMapAligner::TConfigParams alignerParamsFromRos(
 		XmlRpc::XmlRpcValue v;
 		if (pnh.getParam(key, v)) overrides.write("aligner", key, asIniValue(key, v));
 	}
-	params.loadFromConfigFile(overrides, "aligner");
+	loadNaming(params, overrides, "aligner", "parameter " + pnh.getNamespace() + "/");
 
 	// A misspelt key would otherwise leave its default in force unnoticed.
 	std::vector<std::string> names;
@@ -80,19 +102,14 @@ FleetParams fleetParamsFromRos(const ros::NodeHandle& pnh)
 {
 	FleetParams params;
 	std::string config_file;
-	if (pnh.getParam("config_file", config_file) && !config_file.empty())
-	{
-		if (!std::filesystem::is_regular_file(config_file))
-			throw std::invalid_argument("~config_file '" + config_file + "': no such file");
-		params.loadFromConfigFile(mrpt::config::CConfigFile(config_file), "fleet");
-	}
+	if (pnh.getParam("config_file", config_file) && !config_file.empty()) loadIniFile(config_file, "fleet", params);
 	mrpt::config::CConfigFileMemory overrides;
 	for (const auto& f : fleetParamFields())
 	{
 		XmlRpc::XmlRpcValue v;
 		if (pnh.getParam(f.key, v)) overrides.write("fleet", f.key, asIniValue(f.key, v));
 	}
-	params.loadFromConfigFile(overrides, "fleet");
+	loadNaming(params, overrides, "fleet", "parameter " + pnh.getNamespace() + "/");
 	return params;
 }
 
