@@ -42,21 +42,23 @@ HalmstadRun runHalmstadPair(
 		run.mrpt = mrptWithTimeLimit(ctx.self, data.yaml(ref, dir), data.yaml(other, dir), mrpt_limit_s);
 		if (truth && run.mrpt.aligned) run.mrpt_right = judge(run.mrpt.metric, *truth, other_map, ref_rows).right;
 	}
-	if (truth && !(run.merged && run.outcome.right))
+	// Both maps prepared once for what follows: the retry from the
+	// annotation and the candidates' finish.
+	const bool retry = truth && !(run.merged && run.outcome.right);
+	CScalingGridMapAligner::PreparedMapPtr ref_prepared, other_prepared;
+	if (truth && (retry || ctx.candidates))
+		ref_prepared = ctx.aligner().prepare(ref_map.grid), other_prepared = ctx.aligner().prepare(other_map.grid);
+	if (retry)
 	{
 		// Why not: the search, or the evidence? The annotation as a start
 		// (these files' origins are 0: map frames are the grids' frames).
-		const auto ref_p = ctx.aligner().prepare(ref_map.grid), other_p = ctx.aligner().prepare(other_map.grid);
 		const Similarity2D start = truthBetweenMapFrames(*truth, int(other_map.grid.getSizeY()), ref_rows);
-		const auto again = ctx.aligner().alignScaled(*ref_p, *other_p, start);
+		const auto again = ctx.aligner().alignScaled(*ref_prepared, *other_prepared, start);
 		run.retried_from_truth = true;
 		run.right_from_truth = again.success && judge(again.metric, *truth, other_map, ref_rows).right;
 	}
 	// Each candidate judged as it would be reported (the aligner's finish for
 	// maps that bend, finishBent): what a user gets if the decision picks it.
-	CScalingGridMapAligner::PreparedMapPtr ref_prepared, other_prepared;
-	if (truth && ctx.candidates)
-		ref_prepared = ctx.aligner().prepare(ref_map.grid), other_prepared = ctx.aligner().prepare(other_map.grid);
 	const auto error_of = [&](const Similarity2D& cells) {
 		const HalmstadOutcome o = judge(candidateMetric(ref_map, cells, other_map), *truth, other_map, ref_rows);
 		return std::pair<double, bool>{o.mean_displacement_px, o.right};
