@@ -28,8 +28,10 @@ struct BenchContext
 	 * hypothesis and always searches the structure (no decision cuts the
 	 * candidate lists short). */
 	CScalingGridMapAligner::TConfigParams options;
-	/** candidates.csv while calibration data is made; null otherwise. */
+	/** candidates.csv: every run's candidates (what --calibration-data is for). */
 	std::ostream* candidates = nullptr;
+	/** --calibration-data: only the candidates matter (no report's extras). */
+	bool calibration_only = false;
 
 	CScalingGridMapAligner aligner() const;
 	/** A fresh folder name under the system's temporary folder, this run's own. */

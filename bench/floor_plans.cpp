@@ -19,7 +19,7 @@ FloorPlanRun alignOnPlan(
 	const CScalingGridMapAligner& aligner, const std::string& dir)
 {
 	FloorPlanRun run;
-	run.site = sensor.substr(0, sensor.find('_'));
+	run.site = siteOf(sensor);
 	run.plan = HalmstadData::floorPlan(plan_site);
 	run.sensor = sensor;
 	run.positive = plan_site == run.site;

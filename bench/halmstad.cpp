@@ -38,7 +38,6 @@ std::string readGz(const std::string& path)
 	return text;
 }
 
-std::string siteOf(const std::string& map) { return map.substr(0, map.find('_')); }
 bool isSensorMap(const std::string& map) { return map.find("layout") == std::string::npos; }
 
 // Pixel (u, v) (v from the top) → metres of a map_server map with origin 0.
@@ -51,6 +50,8 @@ Eigen::Vector2d metricToPx(const Eigen::Vector2d& m, int rows)
 	return {m.x() / kHalmstadResolution - 0.5, rows - 0.5 - m.y() / kHalmstadResolution};
 }
 }  // namespace
+
+std::string siteOf(const std::string& map) { return map.substr(0, map.find('_')); }
 
 HalmstadData::HalmstadData(const std::string& root) : root_(root)
 {

@@ -30,6 +30,9 @@ constexpr double kHalmstadResolution = 0.05;
  * sites (only reported: never tune on them). */
 inline bool isCalibrationSite(const std::string& site) { return site == "E5" || site == "HIH"; }
 
+/** The site a map of the data set belongs to: E5_01 and E5_layout → E5. */
+std::string siteOf(const std::string& map);
+
 struct HalmstadPair
 {
 	std::string site, src, dst;  //!< maps E5_01 …; OTHER = src, REF = dst

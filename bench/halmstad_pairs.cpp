@@ -14,19 +14,28 @@ namespace multires_bench
 namespace fs = std::filesystem;
 using namespace multires_map_merge;
 
+void HalmstadTally::add(const HalmstadRun& h)
+{
+	++pairs;
+	secs.push_back(h.seconds);
+	if (!h.merged) ++refused;
+	else if (h.outcome.right) ++right, disp.push_back(h.outcome.mean_displacement_px), corr.push_back(h.outcome.corr_rms_px);
+	else ++wrong;
+	if (h.retried_from_truth) ++(h.right_from_truth ? search_missed : evidence_weak);
+	if (h.mrpt.seconds > 0) ++mrpt_ran, mrpt_right += h.mrpt_right, mrpt_timeout += !h.mrpt.finished;
+}
+
 HalmstadRun runHalmstadPair(
 	const BenchContext& ctx, const HalmstadData& data, const std::string& ref, const std::string& other,
 	const std::string& dir, double mrpt_limit_s)
 {
 	HalmstadRun run;
-	run.site = ref.substr(0, ref.find('_'));
+	run.site = siteOf(ref);
 	run.ref = ref, run.other = other;
-	run.positive = run.site == other.substr(0, other.find('_'));
+	run.positive = run.site == siteOf(other);
 	// Calibration data (the issue's): E5 and HIH positives, and every
 	// negative with an E5 or HIH map or plan (docs/decision.md, Calibration).
-	const auto site_of = [](const std::string& map) { return map.substr(0, map.find('_')); };
-	run.calibration = run.positive ? isCalibrationSite(run.site)
-								   : isCalibrationSite(site_of(ref)) || isCalibrationSite(site_of(other));
+	run.calibration = isCalibrationSite(run.site) || isCalibrationSite(siteOf(other));
 	const GridInFrame ref_map = loadGridMap(data.yaml(ref, dir)), other_map = loadGridMap(data.yaml(other, dir));
 	const HalmstadPair* truth = run.positive ? data.pair(other, ref) : nullptr;
 	mrpt::system::CTicTac clock;
@@ -43,8 +52,9 @@ HalmstadRun runHalmstadPair(
 		if (truth && run.mrpt.aligned) run.mrpt_right = judge(run.mrpt.metric, *truth, other_map, ref_rows).right;
 	}
 	// Both maps prepared once for what follows: the retry from the
-	// annotation and the candidates' finish.
-	const bool retry = truth && !(run.merged && run.outcome.right);
+	// annotation (a report's, not the calibration data's) and the
+	// candidates' finish.
+	const bool retry = truth && !ctx.calibration_only && !(run.merged && run.outcome.right);
 	CScalingGridMapAligner::PreparedMapPtr ref_prepared, other_prepared;
 	if (truth && (retry || ctx.candidates))
 		ref_prepared = ctx.aligner().prepare(ref_map.grid), other_prepared = ctx.aligner().prepare(other_map.grid);
@@ -107,7 +117,7 @@ std::vector<HalmstadRun> runHalmstad(
 				for (size_t k = 0; k < all.size() && taken < negatives_per_map; ++k)
 				{
 					const std::string& other = all[(start + k * 7) % all.size()];
-					if (other.substr(0, other.find('_')) == site) continue;
+					if (siteOf(other) == site) continue;
 					runs.push_back(runHalmstadPair(ctx, data, ref, other, dir));
 					++taken;
 				}

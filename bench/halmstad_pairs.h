@@ -30,6 +30,18 @@ struct HalmstadRun
 	bool right_from_truth = false;
 };
 
+/** A site's same-site pairs counted as the report states them. */
+struct HalmstadTally
+{
+	size_t pairs = 0, right = 0, refused = 0, wrong = 0;
+	std::vector<double> disp, corr, secs;  //!< displacement and corr. RMS of the right merges [px]; every pair's time
+	size_t mrpt_ran = 0, mrpt_right = 0, mrpt_timeout = 0;
+	/** Of the pairs not merged right: merged right from the annotation (the
+	 * search missed them), refused from it too (their evidence is too weak). */
+	size_t search_missed = 0, evidence_weak = 0;
+	void add(const HalmstadRun& positive);
+};
+
 /** Aligns REF ← OTHER from map_server files; for positives judges the result
  * against the annotation. Every candidate goes to ctx.candidates with its
  * features and whether it was right: the data the decision is calibrated on. */

@@ -30,6 +30,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 using namespace multires_map_merge;
@@ -71,19 +72,17 @@ int floorPlansOnly(const BenchContext& ctx, const std::string& sites)
 int halmstadOnly(const BenchContext& ctx, const std::string& sites, size_t negatives_per_map)
 {
 	const auto runs = runHalmstad(ctx, HalmstadData(ctx.data + "/halmstad"), siteList(sites), negatives_per_map);
-	size_t right = 0, wrong = 0, pos = 0, false_merges = 0, search_missed = 0, evidence_weak = 0;
+	std::map<std::string, HalmstadTally> per_site;
+	size_t negatives = 0, false_merges = 0, wrong = 0;
 	for (const auto& r : runs)
-		if (r.positive)
-		{
-			++pos, right += r.merged && r.outcome.right, wrong += r.merged && !r.outcome.right;
-			if (r.retried_from_truth) ++(r.right_from_truth ? search_missed : evidence_weak);
-		}
-		else
-			false_merges += r.merged;
-	std::cout << "halmstad: " << right << "/" << pos << " merged right, " << wrong << " merged wrong, " << false_merges
-			  << "/" << runs.size() - pos << " false merges; of the others, from the annotation: " << search_missed
-			  << " merged right (the search missed them), " << evidence_weak << " refused (evidence too weak)\n";
-	return 0;
+		if (r.positive) per_site[r.site].add(r), wrong += r.merged && !r.outcome.right;
+		else ++negatives, false_merges += r.merged;
+	for (const auto& [site, t] : per_site)
+		std::cout << "halmstad " << site << ": " << t.right << "/" << t.pairs << " merged right, " << t.wrong
+				  << " merged wrong; of the others, from the annotation: " << t.search_missed
+				  << " merged right (the search missed them), " << t.evidence_weak << " refused (evidence too weak)\n";
+	std::cout << "halmstad negatives: " << false_merges << "/" << negatives << " merged\n";
+	return wrong + false_merges == 0 ? 0 : 1;
 }
 
 int negativesOnly(const BenchContext& ctx)
@@ -287,6 +286,7 @@ int main(int argc, char** argv)
 			// decision is fitted on the candidates it sees when it runs (the
 			// screen's included), of every pair, not on those a decision kept.
 			ctx.options.exhaustive_search = true;
+			ctx.calibration_only = true;
 			writeCalibrationData(ctx, {extra_arg.getValue(), live_pairs_arg.getValue(), coarser_pairs_arg.getValue(),
 									   floor_plan_pairs_arg.getValue(), size_t(negatives_arg.getValue())});
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;

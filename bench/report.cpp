@@ -33,16 +33,6 @@ bool isSameResolutionWithMrpt(const PairResult& r)
 double oursOverMrpt(const PairResult& r) { return r.seconds / std::max(1e-9, r.mrpt_seconds); }
 
 /** One Halmstad site's sensor pairs. */
-struct SiteRow
-{
-	size_t pairs = 0, right = 0, refused = 0, wrong = 0;
-	std::vector<double> disp, corr, secs;
-	size_t mrpt_ran = 0, mrpt_right = 0, mrpt_timeout = 0;
-	/** Of the pairs not merged right: merged right from the annotation (the
-	 * search missed them), refused from it too (their evidence is too weak). */
-	size_t search_missed = 0, evidence_weak = 0;
-};
-
 /** What more than one section reads (a section's text, a target): computed once. */
 struct Facts
 {
@@ -50,7 +40,7 @@ struct Facts
 	double worst_process_ratio = 0;  //!< whole processes, ours / MRPT
 	std::vector<double> fig8_secs, fig9_secs, mrpt_fig8_secs;  //!< alignment times (NaN: not of the set)
 	size_t false_merges = 0;  //!< CARMEN negatives merged
-	std::map<std::string, SiteRow> sites;  //!< Halmstad sensor pairs per site
+	std::map<std::string, HalmstadTally> sites;  //!< Halmstad sensor pairs per site
 	std::vector<double> halmstad_secs;  //!< every same-site sensor pair
 	size_t acceptance_pairs = 0, acceptance_right = 0, calibration_pairs = 0, calibration_right = 0;
 	size_t halmstad_wrong = 0, cross = 0, cross_merged = 0;
@@ -77,14 +67,7 @@ Facts factsOf(const FullRun& run)
 			continue;
 		}
 		f.halmstad_secs.push_back(h.seconds);
-		SiteRow& row = f.sites[h.site];
-		++row.pairs;
-		row.secs.push_back(h.seconds);
-		if (!h.merged) ++row.refused;
-		else if (h.outcome.right) ++row.right, row.disp.push_back(h.outcome.mean_displacement_px), row.corr.push_back(h.outcome.corr_rms_px);
-		else ++row.wrong;
-		if (h.retried_from_truth) ++(h.right_from_truth ? row.search_missed : row.evidence_weak);
-		if (h.mrpt.seconds > 0) ++row.mrpt_ran, row.mrpt_right += h.mrpt_right, row.mrpt_timeout += !h.mrpt.finished;
+		f.sites[h.site].add(h);
 	}
 	for (const auto& [site, row] : f.sites)
 	{
@@ -383,7 +366,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 	for (const auto& site : {"E5", "HIH", "F5", "KPT4A"})
 	{
 		if (!f.sites.count(site)) continue;
-		const SiteRow& r = f.sites.at(site);
+		const HalmstadTally& r = f.sites.at(site);
 		const bool cal = isCalibrationSite(site);
 		md << "| " << site << " | " << (cal ? "calibration" : "**acceptance**") << " | " << r.pairs << " | "
 		   << r.right << " (" << num(100.0 * r.right / std::max<size_t>(1, r.pairs), 0) << " %) | " << r.refused
