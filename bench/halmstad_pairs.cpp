@@ -76,7 +76,7 @@ HalmstadRun runHalmstadPair(
 	writeCandidates(ctx, run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
 		const auto& o = ctx.options;
 		return ref_prepared
-			? finishBent(*ref_prepared, *other_prepared, c.cells, c.evidence.exact_confidence, o.finishParams(), o.decision)
+			? finishBent(*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision)
 			: c.cells;
 	});
 	std::cout << "halmstad " << ref << " <- " << other << ": "

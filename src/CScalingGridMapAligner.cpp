@@ -216,7 +216,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// (In calibration data, every pair is checked.)
 	const bool rests_on_walls = d.merged &&
 		std::none_of(search.candidates.begin(), search.candidates.end(), [&](const TCandidate& c) {
-			return c.evidence.exact_confidence >= decision.min_confidence;
+			return decision.exactConfidence(c.evidence) >= decision.min_confidence;
 		});
 	if (options.mirror_check && !info.tracked && (rests_on_walls || (d.chosen && options.exhaustive_search)))
 	{
@@ -237,7 +237,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// 6. The decided transform finished (Finish.h).
 	stage.Tic();
 	const Finished finished = finishDecided(
-		ref, other, info.cells, info.evidence.exact_confidence, d.merged, options.finishParams(), decision);
+		ref, other, info.cells, decision.exactConfidence(info.evidence), d.merged, options.finishParams(), decision);
 	if (finished.ran)
 	{
 		info.cells = finished.cells;

@@ -70,6 +70,11 @@ double DecisionParams::score(const Evidence& e) const
 		feature_weight * std::min(e.feature_agreement, feature_cap) / feature_cap;
 }
 
+double DecisionParams::exactConfidence(const Evidence& e) const
+{
+	return e.tolerant_consistency - e.chance_consistency >= exact_min_lead ? e.exact_confidence : 0.0;
+}
+
 bool DecisionParams::areRivals(const Placement& a, const Placement& b) const
 {
 	return !samePlacement(a, b, distinct_shift, distinct_turn_deg, std::log(1 + distinct_scale));
@@ -107,7 +112,7 @@ double DecisionParams::relevantScore(double best_score) const
 bool DecisionParams::mergedWhateverComes(const DecisionCandidate& c, double exact_needed) const
 {
 	const Evidence& e = c.evidence;
-	if (e.exact_confidence >= exact_needed) return true;
+	if (exactConfidence(e) >= exact_needed) return true;
 	const double s = score(e);
 	return !c.screened && e.judged_points >= min_judged_points && s >= runner_up_floor &&
 		confidenceOfValue(s) >= std::max(0.5, min_confidence);
@@ -131,7 +136,7 @@ Decision decide(const std::vector<DecisionCandidate>& cands, const DecisionParam
 	for (size_t i = 0; i < n; ++i)
 	{
 		d.scores[i] = p.score(cands[i].evidence);
-		d.confidence[i] = cands[i].evidence.exact_confidence;
+		d.confidence[i] = p.exactConfidence(cands[i].evidence);
 		if (decidable(cands[i]) && (!d.best || d.scores[i] > d.scores[*d.best])) d.best = i;
 	}
 	// Two ways to be sure: the maps coincide cell for cell (exact_confidence),

@@ -217,7 +217,7 @@ Refined refineInFull(const PairContext& c, const Hypothesis& h, const Screen& s)
 		: 0.0;
 	out.verify_s += clock.Tac();
 	out.cand = candidateOf(c, h, r, rmse_coarse, cell_consistency, judgement);
-	out.cand.confidence = out.cand.evidence.exact_confidence;
+	out.cand.confidence = c.options.decision.exactConfidence(out.cand.evidence);
 	out.r = r;
 	out.valid = true;
 	return out;
@@ -254,7 +254,7 @@ bool record(const PairContext& c, SearchState& state, const Hypothesis& h, const
 			<< " exact conf " << e.exact_confidence;
 	});
 	const DecisionParams& d = c.options.decision;
-	if (!cand.screened && cand.evidence.exact_confidence >= d.min_confidence) state.exact_found.push_back(cand);
+	if (!cand.screened && d.exactConfidence(cand.evidence) >= d.min_confidence) state.exact_found.push_back(cand);
 	return d.mergedWhateverComes(decisionInput(cand), kExactEnough) && !c.options.exhaustive_search;
 }
 

@@ -115,6 +115,31 @@ TEST(Decision, MirroredAndScreenedCandidatesAreNeverChosen)
 	EXPECT_LT(d.value, decide({right}, p).value);
 }
 
+// Maps that coincide cell for cell are merged on that alone, whatever the
+// walls score (a small overlap pays a large evidence discount), but only
+// where that is a peak: the cells of a map shrunk into a few dozen of
+// another place's agree as well a little away.
+TEST(Decision, CellsCoincidingMergeOnlyWhereTheyStandAboveChance)
+{
+	DecisionParams p;
+	Evidence peak;
+	peak.tolerant_consistency = peak.bent_consistency = 0.99;
+	peak.chance_consistency = 0.99 - DecisionParams::exact_min_lead;
+	peak.judged_points = 200;  // walls alone would never merge on so few
+	peak.exact_confidence = 0.9;
+	Evidence flat = peak;
+	flat.chance_consistency = 0.99 - 0.9 * DecisionParams::exact_min_lead;
+	EXPECT_EQ(p.exactConfidence(peak), 0.9);
+	EXPECT_EQ(p.exactConfidence(flat), 0);
+	const Decision on_peak = decide({at(peak, 0)}, p), on_flat = decide({at(flat, 0)}, p);
+	EXPECT_LT(on_peak.value, p.threshold) << "the walls' evidence is too little";
+	EXPECT_TRUE(on_peak.merged);
+	EXPECT_DOUBLE_EQ(on_peak.confidence[0], 0.9);
+	EXPECT_FALSE(on_flat.merged);
+	EXPECT_TRUE(p.mergedWhateverComes(at(peak, 0), 0.5));
+	EXPECT_FALSE(p.mergedWhateverComes(at(flat, 0), 0.5));
+}
+
 TEST(Decision, OnlyTheScoreAndTheRivalsDecideAndARefusalSaysTheValue)
 {
 	DecisionParams p;
