@@ -4,6 +4,7 @@
 #include "coarser_other.h"
 #include "halmstad_pairs.h"
 #include "live_fleet.h"
+#include "ros_maps.h"
 
 #include <multires_map_merge/Finish.h>
 #include <multires_map_merge/GroundTruthPair.h>
@@ -110,7 +111,7 @@ void runCoarserCalibrationPairs(const BenchContext& ctx, const HalmstadData& dat
 		std::ostringstream other_name;
 		other_name << run.other << "_x" << run.factor;
 		writeCandidates(ctx, run.site, run.ref, other_name.str(), true, true, r, error_of, [&](const auto& c) {
-			return finishBent(*ref_prepared, *other_prepared, c.cells, c.evidence.exact_confidence, o.finishParams(), o.decision);
+			return finishBent(*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision);
 		});
 	};
 	runCoarserOther(data, {"E5", "HIH"}, kCoarserFactors, ctx.options, dir, sink);
@@ -165,7 +166,8 @@ void runReverseCalibrationPositives(const BenchContext& ctx, const HalmstadData&
 void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts)
 {
 	const HalmstadData data(ctx.data + "/halmstad");
-	const bool everything = !parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs && !parts.floor_plan_pairs;
+	const bool everything =
+		!parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs && !parts.floor_plan_pairs && !parts.ros_pairs;
 	if (everything)
 	{
 		runHalmstad(ctx, data, {"E5", "HIH"}, parts.negatives_per_map);
@@ -177,6 +179,7 @@ void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts
 	if (everything || parts.live_pairs) runLiveFleetCalibrationPairs(ctx);
 	if (everything || parts.coarser_pairs) runCoarserCalibrationPairs(ctx, data);
 	if (everything || parts.floor_plan_pairs) runFloorPlanCalibrationPairs(ctx, data);
+	if (everything || parts.ros_pairs) runRosMaps(ctx);
 }
 
 }  // namespace multires_bench

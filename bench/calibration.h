@@ -4,8 +4,8 @@
 // and whether it was right, into candidates.csv for
 // scripts/calibrate_decision.py. Calibration sites only (Halmstad E5, HIH),
 // their cross-site negatives in both orders, CARMEN negatives, mirror images,
-// the live fleet's growing maps, OTHER recorded coarser and the sensor maps
-// on the floor plans.
+// the live fleet's growing maps, OTHER recorded coarser, the sensor maps
+// on the floor plans and the independent ROS maps (ros_maps.h).
 
 #include "context.h"
 
@@ -14,7 +14,7 @@ namespace multires_bench
 /** Which parts; all of them when none is set. */
 struct CalibrationParts
 {
-	bool extra_negatives = false, live_pairs = false, coarser_pairs = false, floor_plan_pairs = false;
+	bool extra_negatives = false, live_pairs = false, coarser_pairs = false, floor_plan_pairs = false, ros_pairs = false;
 	size_t negatives_per_map = 8;
 };
 

@@ -85,6 +85,14 @@ int halmstadOnly(const BenchContext& ctx, const std::string& sites, size_t negat
 	return wrong + false_merges == 0 ? 0 : 1;
 }
 
+int rosMapsOnly(const BenchContext& ctx)
+{
+	const auto runs = runRosMaps(ctx);
+	writeRosMapsSection(std::cout, runs);
+	const bool wrong = std::any_of(runs.begin(), runs.end(), [](const RosMapsRun& r) { return r.merged && !r.right; });
+	return wrong ? 1 : 0;
+}
+
 int negativesOnly(const BenchContext& ctx)
 {
 	const auto negatives = runCarmenNegatives(ctx);
@@ -139,7 +147,7 @@ void runMatrices(const BenchContext& ctx, FullRun& run)
 }
 
 /** Halmstad sensor pairs and cross-site negatives, floor plans, OTHER
- * recorded coarser, and the Willow pair. */
+ * recorded coarser, the independent ROS maps and the Willow pair. */
 void runRealMaps(const BenchContext& ctx, FullRun& run)
 {
 	const HalmstadData data(ctx.data + "/halmstad");
@@ -157,6 +165,7 @@ void runRealMaps(const BenchContext& ctx, FullRun& run)
 		run.floor_plans = runFloorPlans(data, data.sites(), ctx.options, dir);
 		run.coarser = runCoarserOther(data, data.sites(), kCoarserFactors, ctx.options, dir);
 		fs::remove_all(dir);
+		run.ros_maps = runRosMaps(ctx);
 	}
 	const std::string w = ctx.data + "/ros_maps/willow/";
 	run.willow = ctx.aligner().alignScaled(
@@ -238,6 +247,9 @@ int main(int argc, char** argv)
 		"", "scaling-only", "only the scaling case of this many cells a side (e.g. 4000)", false, 0, "CELLS", cmd);
 	TCLAP::SwitchArg live_arg(
 		"", "live-only", "only the live node's latency (printed as markdown); exit 1 if a robot was ever placed wrong", cmd);
+	TCLAP::SwitchArg ros_maps_arg(
+		"", "ros-maps-only", "only the independent ROS maps (ros_maps, SOURCES.md 2b); with --calibration-data: their candidates",
+		cmd);
 	TCLAP::SwitchArg negatives_only_arg(
 		"", "negatives-only", "only the CARMEN pairs that must not merge (different buildings, disjoint parts)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
@@ -288,7 +300,7 @@ int main(int argc, char** argv)
 			ctx.options.exhaustive_search = true;
 			ctx.calibration_only = true;
 			writeCalibrationData(ctx, {extra_arg.getValue(), live_pairs_arg.getValue(), coarser_pairs_arg.getValue(),
-									   floor_plan_pairs_arg.getValue(), size_t(negatives_arg.getValue())});
+									   floor_plan_pairs_arg.getValue(), ros_maps_arg.getValue(), size_t(negatives_arg.getValue())});
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
 		}
@@ -297,6 +309,7 @@ int main(int argc, char** argv)
 		if (halmstad_arg.isSet()) return halmstadOnly(ctx, halmstad_arg.getValue(), negatives_arg.getValue());
 		if (sets_arg.isSet()) return runAccuracySets(ctx, sets_arg.getValue());
 		if (negatives_only_arg.isSet()) return negativesOnly(ctx);
+		if (ros_maps_arg.isSet()) return rosMapsOnly(ctx);
 		if (live_arg.isSet()) return liveOnly(ctx);
 		if (scaling_arg.isSet())
 		{

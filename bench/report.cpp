@@ -383,6 +383,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 	   << " (reference and tolerance: README, test_real_maps).\n";
 	if (!floor_plans.empty()) writeFloorPlanSection(md, floor_plans);
 	if (!coarser.empty()) writeCoarserSection(md, coarser);
+	if (!run.ros_maps.empty()) writeRosMapsSection(md, run.ros_maps);
 }
 
 void writeScalingSection(std::ostream& md, const FullRun& run)

@@ -9,6 +9,7 @@
 #include "halmstad_fleets.h"
 #include "halmstad_pairs.h"
 #include "live_fleet.h"
+#include "ros_maps.h"
 #include "scaling.h"
 
 #include <string>
@@ -26,6 +27,7 @@ struct FullRun
 	std::vector<HalmstadRun> halmstad;
 	std::vector<FloorPlanRun> floor_plans;
 	std::vector<CoarserRun> coarser;
+	std::vector<RosMapsRun> ros_maps;
 	CScalingGridMapAligner::TReturnInfo willow;
 	std::vector<ScalingCase> scaling;
 	std::vector<WholeProcessRow> processes;

@@ -27,7 +27,7 @@ if [ ${#quick[@]} -eq 0 ]; then
     echo
     echo "## The decision, validated leave one site out"
     echo
-    echo "\`scripts/calibrate_decision.py\` on the calibration samples (${#samples[@]} files: $(for s in "${samples[@]}"; do printf '`%s` ' "$(basename "$s")"; done)). The calibration pairs are grouped by the calibration site they touch (E5, HIH, the CARMEN negatives, the live fleet's growing maps); each group is left out in turn. *Refit*: the whole fit made again without the group, judged on it. *This model*: the defaults' model with only its threshold set again without the group (its highest wrong value plus the least margin): how far a new site's wrong values rise above what the others showed, which sets the margin (docs/decision.md, Calibration). F5 and KPT4A stay out of every fit."
+    echo "\`scripts/calibrate_decision.py\` on the calibration samples (${#samples[@]} files: $(for s in "${samples[@]}"; do printf '`%s` ' "$(basename "$s")"; done)). The calibration pairs are grouped by the calibration site they touch (E5, HIH, the CARMEN negatives, the live fleet's growing maps, the independent ROS maps); each group is left out in turn. *Refit*: the whole fit made again without the group, judged on it. *This model*: the defaults' model with only its threshold set again without the group (its highest wrong value plus the least margin): how far a new site's wrong values rise above what the others showed, which sets the margin (docs/decision.md, Calibration). F5 and KPT4A stay out of every fit."
     echo
     cat "$table"
   } >>"$out/REPORT.md"

@@ -22,7 +22,9 @@ CARMEN different-building and disjoint-part pairs, the first 15 % of a CARMEN
 run against a whole other building, every E5 and HIH map against its own
 mirror image, and the live bench's growing maps at a few states (site "live":
 each fr079 robot against each other, whose wrong best candidates must not
-merge, and against the intel robot). The E5/HIH pairs with OTHER recorded
+merge, and against the intel robot), and the independent ROS maps (site
+"ros": every ordered pair of a place, positives judged against a
+brute-force truth, and every map against the other places' maps). The E5/HIH pairs with OTHER recorded
 coarser are left out (not_fitted). F5 and KPT4A are the acceptance set:
 their own pairs are never read here; their maps and plans serve only as
 other buildings for E5 and HIH maps.
@@ -48,7 +50,7 @@ smaller runner-up weight, feature weight and distinct shift; then the larger
 chance weight, evidence and floor).
 
 Leave-one-site-out: the calibration pairs are grouped by the calibration
-sites they touch (E5, HIH, CARMEN, the live fleet); for each group the fit is
+sites they touch (E5, HIH, CARMEN, the live fleet, the ROS maps); for each group the fit is
 made on the pairs that do not touch it and judged on those that do: how many
 of its positives merge right, how many pairs merge wrong, and by how much its
 highest wrong value overshoots the highest wrong value the fit saw. The
@@ -100,7 +102,7 @@ MIN_JUDGED = 40  # DecisionParams::min_judged_points
 LIVE_NEAR_CELLS = 5.0
 CALIBRATION_SITES = ("E5", "HIH")
 # Leave-one-site-out groups, in the table's order.
-GROUPS = ("E5", "HIH", "carmen", "live")
+GROUPS = ("E5", "HIH", "carmen", "live", "ros")
 
 Fit = collections.namedtuple("Fit", "rank w e fw fcap k floor ds threshold highest_wrong merged_right live_right")
 
@@ -145,7 +147,7 @@ def not_fitted(row):
 def groups_of(key):
     """The leave-one-site-out groups a pair touches."""
     site, ref, other, _ = key
-    if site in ("carmen", "live"):
+    if site in ("carmen", "live", "ros"):
         return {site}
     return {name.split("_")[0] for name in (ref, other)} & set(CALIBRATION_SITES)
 
@@ -344,11 +346,16 @@ def main():
     if replayed is None:
         print("# decision-replay not built: the fit was not replayed by the aligner's decision")
     else:
-        print(f"# replayed by the aligner's decision (decision-replay): {replayed[0]} positive pairs merged right, "
-              f"{replayed[1]} merged wrong")
-        if replayed != (best.merged_right, 0):
-            sys.exit(f"calibrate_decision.py: the aligner's decision disagrees with this script's: {replayed} "
-                     f"against ({best.merged_right}, 0)")
+        right, wrong, by_cells = replayed
+        tops, scores = tops_of(data, score_fn(best.w, best.e, best.fw, best.fcap))
+        values = values_of(data, tops, scores, best.k, best.floor, best.ds)
+        on_walls = {key for key in data.positives if tops.get(key, {}).get("right") and values[key] >= best.threshold}
+        print(f"# replayed by the aligner's decision (decision-replay): {len(right)} positive pairs merged right "
+              f"({len(by_cells & right)} on coinciding cells, which no fitted number moves), {len(wrong)} merged wrong")
+        if right != on_walls | (by_cells & right) or wrong:
+            sys.exit(f"calibrate_decision.py: the aligner's decision disagrees with this script's: "
+                     f"{len(right)} merged right, {len(wrong)} wrong, against {len(on_walls)} on the walls and "
+                     f"{len(by_cells & right)} on coinciding cells")
     if expected_ini:
         differ = differences(ini, expected_ini)
         if differ:
@@ -391,7 +398,9 @@ def differences(fit_ini, defaults_path):
 
 def replay(paths, ini_text):
     """The fit replayed by the aligner's own decision (decision-replay): the
-    calibration positives merged right and the pairs merged wrong, over all
+    calibration positive pairs merged right, the pairs merged wrong, and the
+    pairs merged on coinciding cells (the exact path, whatever the walls'
+    value: this script does not fit it), as sets of pair keys over all
     samples, by the same rules as above. None when the tool is not built."""
     tool = os.environ.get("DECISION_REPLAY") or os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "..", "build", "devel", "lib", "multires_map_merge",
@@ -401,19 +410,23 @@ def replay(paths, ini_text):
     with tempfile.NamedTemporaryFile("w", suffix=".ini") as ini:
         ini.write(ini_text)
         ini.flush()
-        right = wrong = 0
+        right, wrong, by_cells = set(), set(), set()
         for path in paths:
             out = subprocess.run([tool, path, "--config", ini.name], check=True, capture_output=True, text=True).stdout
             for r in csv.DictReader(io.StringIO(out)):
                 if r["calibration"] != "1" or r["merged"] != "1" or not_fitted(r):
                     continue
+                key = (r["site"], r["ref"], r["other"], path)
                 near = (r["site"] == "live" and r["right"] != "1" and r["error"] != "nan"
                         and float(r["error"]) <= LIVE_NEAR_CELLS)
+                if r["by_cells"] == "1":
+                    by_cells.add(key)
                 if r["right"] == "1":
-                    right += r["site"] != "live"
+                    if r["site"] != "live":
+                        right.add(key)
                 elif not near:
-                    wrong += 1
-    return right, wrong
+                    wrong.add(key)
+    return right, wrong, by_cells
 
 
 if __name__ == "__main__":

@@ -164,6 +164,8 @@ Decision decide(const std::vector<DecisionCandidate>& cands, const DecisionParam
 	for (size_t i = 0; i < n; ++i)
 		if (!cands[i].mirrored && (!d.chosen || before(i, *d.chosen))) d.chosen = i;
 	d.merged = d.chosen && d.confidence[*d.chosen] >= p.min_confidence;
+	for (size_t i = 0; i < n; ++i)
+		d.by_cells |= !cands[i].mirrored && p.exactConfidence(cands[i].evidence) >= p.min_confidence;
 	return d;
 }
 

@@ -177,6 +177,10 @@ struct Decision
 	double runner_up_score = std::numeric_limits<double>::quiet_NaN();
 	double value = std::numeric_limits<double>::quiet_NaN();
 	bool merged = false;  //!< chosen, with confidence ≥ min_confidence
+	/** Merged on coinciding cells (a candidate's exactConfidence ≥
+	 * min_confidence), whatever the walls' decision value: no fitted number
+	 * moves it. */
+	bool by_cells = false;
 };
 
 Decision decide(const std::vector<DecisionCandidate>& candidates, const DecisionParams& p);

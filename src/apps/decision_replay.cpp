@@ -127,7 +127,7 @@ int main(int argc, char** argv)
 			size_t pairs = 0, positives = 0, right = 0, wrong = 0;
 		};
 		std::map<std::string, Tally> tally;
-		std::cout << "site,ref,other,positive,calibration,candidates,merged,right,error,confidence,value\n";
+		std::cout << "site,ref,other,positive,calibration,candidates,merged,right,error,confidence,value,by_cells\n";
 		for (const Pair& p : loadPairs(csv_arg.getValue()))
 		{
 			const Decision d = decide(p.candidates, params);
@@ -136,7 +136,7 @@ int main(int argc, char** argv)
 			const double confidence = d.chosen ? d.confidence[*d.chosen] : 0.0;
 			std::cout << p.site << "," << p.ref << "," << p.other << "," << p.positive << "," << p.calibration << ","
 					  << p.candidates.size() << "," << d.merged << "," << right << "," << error << "," << confidence
-					  << "," << d.value << "\n";
+					  << "," << d.value << "," << d.by_cells << "\n";
 			Tally& t = tally[p.site + (p.calibration ? " (calibration)" : "")];
 			++t.pairs;
 			t.positives += p.positive;
