@@ -534,7 +534,7 @@ void writeSpeedTargets(std::ostream& md, const BenchContext& ctx, const FullRun&
 	}
 }
 
-/** Real independent maps: Halmstad sensor pairs, floor plans, OTHER recorded coarser. */
+/** Real independent maps: Halmstad sensor pairs, floor plans, OTHER recorded coarser, the ROS maps. */
 void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 {
 	const auto &floor_plans = run.floor_plans;
@@ -569,6 +569,12 @@ void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 		   std::to_string(plans.merged_wrong + plans.negatives_merged) + " (of " +
 			   std::to_string(plans.negatives) + " negatives)",
 		   plans.merged_wrong + plans.negatives_merged == 0);
+	size_t ros_wrong = 0, ros_negatives = 0;
+	for (const auto& r : run.ros_maps) ros_wrong += r.merged && !r.right, ros_negatives += !r.positive;
+	target("0 merged wrong over the independent ROS maps: same place and other places",
+		   std::to_string(ros_wrong) + " (of " + std::to_string(run.ros_maps.size()) + " pairs, " +
+			   std::to_string(ros_negatives) + " of different places)",
+		   ros_wrong == 0);
 }
 
 void writeTargets(std::ostream& md, const BenchContext& ctx, const FullRun& run, const Facts& f)
