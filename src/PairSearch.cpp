@@ -223,9 +223,14 @@ Refined refineInFull(const PairContext& c, const Hypothesis& h, const Screen& s)
 	return out;
 }
 
-/** The screen's bar: below it a hypothesis can neither merge nor, as a
- * rival, lower the best candidate's confidence, beyond the sample's noise.
- * Raised as better candidates are found (relevantScore only rises). */
+/** The screen's bar: below it a hypothesis can neither merge nor lower a
+ * sure best candidate's confidence below 1, beyond the sample's noise.
+ * Raised as better candidates are found (relevantScore only rises). Never
+ * below the lowest mergeable score (less the margin): a rival between the
+ * floor and that bar, which would lower a marginal best's value, is
+ * screened away. Counted at their sample scores on the calibration data,
+ * such rivals change one merge in about 340 (a right one, refused), at
+ * about 40 % more full judgements. */
 double screenBar(const PairContext& c, const SearchState& state)
 {
 	const auto& o = c.options;

@@ -140,7 +140,8 @@ struct DecisionParams
 	double lowestMergeableScore() const;
 	/** The least score a further candidate needs to matter once the best so
 	 * far scores `best_score`: to merge, to beat it, or as a rival to lower
-	 * its confidence below 1. */
+	 * its confidence below 1; never below lowestMergeableScore (rivals of a
+	 * marginal best below it are not sought: PairSearch.cpp, screenBar). */
 	double relevantScore(double best_score) const;
 	/** Merged whatever other candidates come: the maps coincide cell for
 	 * cell (exact_confidence ≥ exact_needed), or its score alone reaches the
