@@ -130,47 +130,54 @@ std::string yamlOf(const BenchContext& ctx, const RosPlace& place, const std::st
 	return ctx.data + "/ros_maps/" + place.dir + "/" + map + ".yaml";
 }
 
+/** Every map of every place, read once: "place/stem" → map. */
+using RosMaps = std::map<std::string, GridInFrame>;
+
 RosMapsRun runPair(
-	const BenchContext& ctx, const RosPlace& ref_place, const std::string& ref_map, const RosPlace& other_place,
-	const std::string& other_map, const Similarity2D* truth_cells)
+	const BenchContext& ctx, const RosMaps& maps, const std::string& ref_place, const std::string& ref_name,
+	const std::string& other_name, const Similarity2D* truth_cells)
 {
 	RosMapsRun run;
-	run.place = ref_place.name;
-	run.ref = ref_place.name + "/" + ref_map, run.other = other_place.name + "/" + other_map;
+	run.place = ref_place;
+	run.ref = ref_name, run.other = other_name;
 	run.positive = truth_cells != nullptr;
-	const GridInFrame ref = loadGridMap(yamlOf(ctx, ref_place, ref_map));
-	const GridInFrame other = loadGridMap(yamlOf(ctx, other_place, other_map));
+	const GridInFrame &ref = maps.at(ref_name), &other = maps.at(other_name);
 	mrpt::system::CTicTac clock;
 	const auto r = ctx.aligner().alignScaled(ref, other);
 	run.seconds = clock.Tac();
 	run.merged = r.success, run.confidence = r.confidence, run.message = r.message;
-	const auto points = occupiedPointsInMapFrame(other);
-	const double cell = ref.grid.getResolution();
-	const auto displacement = [&](const Similarity2D& metric) {
-		double sum = 0;
-		const Similarity2D truth = candidateMetric(ref, *truth_cells, other);
-		for (const auto& p : points) sum += (metric(p) - truth(p)).norm();
-		return sum / std::max<size_t>(1, points.size()) / cell;
-	};
-	if (run.positive && r.candidates.size())
+	if (!run.positive)
+		writeCandidates(ctx, "ros", run.ref, run.other, false, true, r, noTruth);
+	else
 	{
-		run.displacement_cells = displacement(r.metric);
-		run.right = run.merged && run.displacement_cells <= kRosRightCells;
+		const auto points = occupiedPointsInMapFrame(other);
+		const Similarity2D truth = candidateMetric(ref, *truth_cells, other);
+		const auto displacement = [&](const Similarity2D& metric) {
+			double sum = 0;
+			for (const auto& p : points) sum += (metric(p) - truth(p)).norm();
+			return sum / std::max<size_t>(1, points.size()) / ref.grid.getResolution();
+		};
+		if (r.candidates.size())
+		{
+			run.displacement_cells = displacement(r.metric);
+			run.right = run.merged && run.displacement_cells <= kRosRightCells;
+		}
+		// Each candidate judged as it would be reported (the finish), as the
+		// Halmstad pairs are.
+		const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
+		const auto& o = ctx.options;
+		writeCandidates(
+			ctx, "ros", run.ref, run.other, true, true, r,
+			[&](const Similarity2D& cells) {
+				const double e = displacement(candidateMetric(ref, cells, other));
+				return std::pair<double, bool>{e, e <= kRosRightCells};
+			},
+			[&](const auto& c) {
+				return finishBent(
+					*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(),
+					o.decision);
+			});
 	}
-	// Each candidate judged as it would be reported (the finish), as the
-	// Halmstad pairs are.
-	const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
-	const auto& o = ctx.options;
-	writeCandidates(
-		ctx, "ros", run.ref, run.other, run.positive, true, r,
-		[&](const Similarity2D& cells) {
-			if (!run.positive) return noTruth(cells);
-			const double e = displacement(candidateMetric(ref, cells, other));
-			return std::pair<double, bool>{e, e <= kRosRightCells};
-		},
-		[&](const auto& c) {
-			return finishBent(*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision);
-		});
 	std::cout << "ros maps " << run.ref << " <- " << run.other << ": "
 			  << (run.positive ? (run.merged ? (run.right ? "merged right" : "MERGED WRONG") : "refused")
 						   : (run.merged ? "MERGED (false)" : "refused (other place)"))
@@ -195,28 +202,27 @@ Similarity2D bruteForceRigid(const cv::Mat& ref_classes, const cv::Mat& other_cl
 
 std::vector<RosMapsRun> runRosMaps(const BenchContext& ctx)
 {
+	RosMaps maps;
+	for (const RosPlace& place : kRosPlaces)
+		for (const auto& m : place.maps) maps.emplace(place.name + "/" + m, loadGridMap(yamlOf(ctx, place, m)));
 	std::vector<RosMapsRun> runs;
 	for (const RosPlace& place : kRosPlaces)
-	{
-		std::map<std::string, GridInFrame> maps;
-		for (const auto& m : place.maps) maps.emplace(m, loadGridMap(yamlOf(ctx, place, m)));
 		for (size_t a = 0; a < place.maps.size(); ++a)
 			for (size_t b = a + 1; b < place.maps.size(); ++b)
 			{
-				const std::string &ma = place.maps[a], &mb = place.maps[b];
-				const Similarity2D b_to_a =
-					bruteForceRigid(toClassImage(maps.at(ma).grid), toClassImage(maps.at(mb).grid));
+				const std::string ma = place.name + "/" + place.maps[a], mb = place.name + "/" + place.maps[b];
+				const Similarity2D b_to_a = bruteForceRigid(toClassImage(maps.at(ma).grid), toClassImage(maps.at(mb).grid));
 				const Similarity2D a_to_b = b_to_a.inverse();
-				runs.push_back(runPair(ctx, place, ma, place, mb, &b_to_a));
-				runs.push_back(runPair(ctx, place, mb, place, ma, &a_to_b));
+				runs.push_back(runPair(ctx, maps, place.name, ma, mb, &b_to_a));
+				runs.push_back(runPair(ctx, maps, place.name, mb, ma, &a_to_b));
 			}
-	}
 	for (const RosPlace& ref_place : kRosPlaces)
 		for (const RosPlace& other_place : kRosPlaces)
 			if (&ref_place != &other_place)
 				for (const auto& ref : ref_place.maps)
 					for (const auto& other : other_place.maps)
-						runs.push_back(runPair(ctx, ref_place, ref, other_place, other, nullptr));
+						runs.push_back(runPair(
+							ctx, maps, ref_place.name, ref_place.name + "/" + ref, other_place.name + "/" + other, nullptr));
 	return runs;
 }
 

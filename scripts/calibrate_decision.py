@@ -341,14 +341,14 @@ def main():
            f"decision_runner_up_weight = {best.k}\ndecision_runner_up_floor = {best.floor}\n"
            f"distinct_shift = {best.ds}\ndecision_threshold = {best.threshold:.3f}\n")
     print("\n" + ini, end="")
+    tops, scores = tops_of(data, score_fn(best.w, best.e, best.fw, best.fcap))
+    values = values_of(data, tops, scores, best.k, best.floor, best.ds)
     # The fit as the aligner decides it (its own code, not this script's).
     replayed = replay(paths, ini)
     if replayed is None:
         print("# decision-replay not built: the fit was not replayed by the aligner's decision")
     else:
         right, wrong, by_cells = replayed
-        tops, scores = tops_of(data, score_fn(best.w, best.e, best.fw, best.fcap))
-        values = values_of(data, tops, scores, best.k, best.floor, best.ds)
         on_walls = {key for key in data.positives if tops.get(key, {}).get("right") and values[key] >= best.threshold}
         print(f"# replayed by the aligner's decision (decision-replay): {len(right)} positive pairs merged right "
               f"({len(by_cells & right)} on coinciding cells, which no fitted number moves), {len(wrong)} merged wrong")
@@ -364,8 +364,6 @@ def main():
     print(f"# calibration: {best.merged_right}/{len(data.positives)} positive pairs merged right, 0 wrong "
           f"(margin {margin:.3f} x (1 + runner-up weight) above the highest wrong value); live fleet pairs merged "
           f"right {best.live_right}/{len(data.live)}")
-    tops, scores = tops_of(data, score_fn(best.w, best.e, best.fw, best.fcap))
-    values = values_of(data, tops, scores, best.k, best.floor, best.ds)
     for path in paths:
         keys = [key for key in data.positives if key[3] == path]
         merged = [key for key in keys if tops.get(key, {}).get("right") and values[key] >= best.threshold]

@@ -137,6 +137,7 @@ Decision decide(const std::vector<DecisionCandidate>& cands, const DecisionParam
 	{
 		d.scores[i] = p.score(cands[i].evidence);
 		d.confidence[i] = p.exactConfidence(cands[i].evidence);
+		d.by_cells |= !cands[i].mirrored && d.confidence[i] >= p.min_confidence;
 		if (decidable(cands[i]) && (!d.best || d.scores[i] > d.scores[*d.best])) d.best = i;
 	}
 	// Two ways to be sure: the maps coincide cell for cell (exact_confidence),
@@ -164,8 +165,6 @@ Decision decide(const std::vector<DecisionCandidate>& cands, const DecisionParam
 	for (size_t i = 0; i < n; ++i)
 		if (!cands[i].mirrored && (!d.chosen || before(i, *d.chosen))) d.chosen = i;
 	d.merged = d.chosen && d.confidence[*d.chosen] >= p.min_confidence;
-	for (size_t i = 0; i < n; ++i)
-		d.by_cells |= !cands[i].mirrored && p.exactConfidence(cands[i].evidence) >= p.min_confidence;
 	return d;
 }
 
