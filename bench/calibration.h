@@ -2,7 +2,7 @@
 // The decision's calibration data (multires_bench --calibration-data):
 // every candidate of every pair the decision is fitted on, with its evidence
 // and whether it was right, into candidates.csv for
-// scripts/calibrate_decision.py. Calibration sites only (Halmstad E5, HIH),
+// decision-fit. Calibration sites only (Halmstad E5, HIH),
 // their cross-site negatives in both orders, CARMEN negatives, mirror images,
 // the live fleet's growing maps, OTHER recorded coarser, the sensor maps
 // on the floor plans and the independent ROS maps (ros_maps.h).

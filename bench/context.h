@@ -52,7 +52,7 @@ std::pair<double, bool> noTruth(const Similarity2D&);
 
 /** Every refined hypothesis of the pair, with its evidence and whether it
  * was right (`error_of` judged on `reported_of(candidate)`; the refined
- * cells when not given): what scripts/calibrate_decision.py fits the
+ * cells when not given): what decision-fit fits the
  * decision on. Nothing unless ctx.candidates. */
 void writeCandidates(
 	const BenchContext& ctx, const std::string& site, const std::string& ref, const std::string& other, bool positive,

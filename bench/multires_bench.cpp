@@ -214,7 +214,7 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<std::string> data_arg("", "data", "the shared data folder", false, "", "DIR", cmd);
 	TCLAP::SwitchArg calibration_arg(
 		"", "calibration-data", "only the calibration data (Halmstad E5/HIH, E5 cross-site and CARMEN negatives) "
-		"into candidates.csv, for scripts/calibrate_decision.py", cmd);
+		"into candidates.csv, for decision-fit", cmd);
 	TCLAP::ValueArg<std::string> config_arg(
 		"", "config",
 		"aligner parameters, section [aligner] of an MRPT ini file (calibration data made with other defaults)",

@@ -357,7 +357,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 		  "**right** = reported merged with the mean displacement of OTHER's occupied pixels against the annotated "
 		  "similarity ≤ 40 px *and* the annotated inlier correspondences' RMS ≤ max(2 × the annotation's own "
 		  "`rms_px`, 40 px). E5 and HIH are the calibration sites (the decision was tuned on them, "
-		  "`scripts/calibrate_decision.py`); **F5 and KPT4A are the acceptance set: never tuned on**. "
+		  "`decision-fit`); **F5 and KPT4A are the acceptance set: never tuned on**. "
 		  "*Not merged right, from the annotation*: each such pair aligned again with the annotated similarity as "
 		  "its first hypothesis (then the usual search and decision): merged right then, the search missed it; "
 		  "refused again, what its walls say is too weak to merge on.\n\n"

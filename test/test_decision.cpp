@@ -1,5 +1,5 @@
 // The decision module on fixed evidence: no maps, no ICP. What the aligner,
-// the benchmark and decision-replay all call.
+// the benchmark and decision-replay and decision-fit all call.
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/Decision.h>
 

@@ -133,7 +133,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double verify_shift = 12.0;
 		double verify_turn_deg = 8.0;
 		/** --- Decision (Decision.h; docs/decision.md): calibrated by
-		 * scripts/calibrate_decision.py on Halmstad E5/HIH, cross-site,
+		 * decision-fit on Halmstad E5/HIH, cross-site,
 		 * CARMEN, mirror and live-fleet data. Ini keys decision_*,
 		 * distinct_shift and min_confidence (decisionParamFields()). */
 		DecisionParams decision;
