@@ -2,6 +2,8 @@
 
 #include <multires_map_merge/Decision.h>
 
+#include <mrpt/config/CConfigFile.h>
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -87,6 +89,22 @@ pid_t spawnSelf(std::vector<std::string> args, const std::string& out_path)
 	const bool started = posix_spawn(&pid, args[0].c_str(), &fa, nullptr, argv.data(), environ) == 0;
 	posix_spawn_file_actions_destroy(&fa);
 	return started ? pid : -1;
+}
+
+void BenchContext::loadConfig(const std::string& path)
+{
+	if (!fs::is_regular_file(path)) throw std::runtime_error("'" + path + "': no such config file");
+	const mrpt::config::CConfigFile file(path);
+	options.loadFromConfigFile(file, "aligner");
+	fleet.loadFromConfigFile(file, "fleet");
+	config = path;
+}
+
+std::vector<std::string> BenchContext::selfWith(std::vector<std::string> args) const
+{
+	args.insert(args.begin(), self);
+	if (!config.empty()) args.insert(args.end(), {"--config", config});
+	return args;
 }
 
 void runSelf(const std::vector<std::string>& args, const std::string& out_path)

@@ -5,6 +5,7 @@
 // calibration data's writer (candidates.csv) when the run makes it.
 
 #include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/FleetMerge.h>
 
 #include <sys/types.h>
 
@@ -18,6 +19,7 @@ namespace multires_bench
 {
 using multires_map_merge::CScalingGridMapAligner;
 using multires_map_merge::Similarity2D;
+using multires_map_merge::FleetParams;
 
 struct BenchContext
 {
@@ -28,12 +30,20 @@ struct BenchContext
 	 * hypothesis and always searches the structure (no decision cuts the
 	 * candidate lists short). */
 	CScalingGridMapAligner::TConfigParams options;
+	/** The fleet's defaults, or section [fleet] of --config. */
+	FleetParams fleet;
+	/** --config's file ("" without): children read it too. */
+	std::string config;
 	/** candidates.csv: every run's candidates (what --calibration-data is for). */
 	std::ostream* candidates = nullptr;
 	/** --calibration-data: only the candidates matter (no report's extras). */
 	bool calibration_only = false;
 
 	CScalingGridMapAligner aligner() const;
+	/** Reads --config (sections [aligner] and [fleet]); throws naming it. */
+	void loadConfig(const std::string& path);
+	/** This program with `args`, and --config when given: a child's command. */
+	std::vector<std::string> selfWith(std::vector<std::string> args) const;
 	/** A fresh folder name under the system's temporary folder, this run's own. */
 	std::string tempDir(const std::string& what) const;
 };

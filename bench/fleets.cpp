@@ -29,7 +29,7 @@ int fleetChild(const BenchContext& ctx, const std::string& dir)
 	for (int i = 0; fs::exists(dir + "/map_" + std::to_string(i) + ".yaml"); ++i)
 		maps.push_back(loadGridMap(dir + "/map_" + std::to_string(i) + ".yaml"));
 	mrpt::system::CTicTac clock;
-	const FleetParams fp;
+	const FleetParams& fp = ctx.fleet;
 	const FleetResult r = placeFleet(maps, 0, ctx.aligner(), fp);
 	const double placing = clock.Tac();
 	const FusedFleet fused = fuseFleet(maps, r, 0, maps[0].grid.getResolution());
@@ -58,7 +58,7 @@ int fleetChild(const BenchContext& ctx, const std::string& dir)
 std::string placeFleetInChild(const BenchContext& ctx, const std::string& dir)
 {
 	const std::string out = dir + "/out.txt";
-	runSelf({ctx.self, "--fleet-child", dir}, out);
+	runSelf(ctx.selfWith({"--fleet-child", dir}), out);
 	return out;
 }
 

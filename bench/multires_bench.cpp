@@ -217,7 +217,7 @@ int main(int argc, char** argv)
 		"into candidates.csv, for decision-fit", cmd);
 	TCLAP::ValueArg<std::string> config_arg(
 		"", "config",
-		"aligner parameters, section [aligner] of an MRPT ini file (calibration data made with other defaults)",
+		"parameters: sections [aligner] and [fleet] of an MRPT ini file (e.g. calibration data made with other defaults)",
 		false, "", "FILE.ini", cmd);
 	TCLAP::SwitchArg extra_arg("", "extra-negatives-only", "with --calibration-data: only the mirror and 8-vs-5 cm negatives", cmd);
 	TCLAP::SwitchArg coarser_pairs_arg(
@@ -270,6 +270,15 @@ int main(int argc, char** argv)
 	ctx.quick = quick_arg.getValue();
 	ctx.data = data_arg.getValue();
 	if (ctx.data.empty()) ctx.data = (fs::path(argv[0]).parent_path() / "../../../../shared/data").lexically_normal();
+	try
+	{
+		if (config_arg.isSet()) ctx.loadConfig(config_arg.getValue());
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "multires_bench: " << e.what() << "\n";
+		return 2;
+	}
 	if (child_ref.isSet()) return scalingChild(ctx, child_ref.getValue(), child_other.getValue());
 	if (mrpt_child.isSet()) return mrptChild(mrpt_child.getValue(), child_other.getValue());
 	if (fleet_child.isSet()) return fleetChild(ctx, fleet_child.getValue());
@@ -281,12 +290,6 @@ int main(int argc, char** argv)
 	}
 	try
 	{
-		if (config_arg.isSet())
-		{
-			if (!fs::is_regular_file(config_arg.getValue()))
-				throw std::runtime_error("'" + config_arg.getValue() + "': no such config file");
-			ctx.options.loadFromConfigFile(mrpt::config::CConfigFile(config_arg.getValue()), "aligner");
-		}
 		const std::string out = out_arg.getValue();
 		fs::create_directories(out);
 		std::ofstream candidates(out + "/candidates.csv");

@@ -119,7 +119,7 @@ ScalingCase runScalingCase(const BenchContext& ctx, int cells)
 			other_path);
 	}
 	const auto started = std::chrono::steady_clock::now();
-	runSelf({ctx.self, "--scaling-align", ref_path, "--scaling-other", other_path}, out);
+	runSelf(ctx.selfWith({"--scaling-align", ref_path, "--scaling-other", other_path}), out);
 	c.process_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 	std::ifstream f(out);
 	std::string line;
@@ -173,7 +173,7 @@ WholeProcessRow runWholeProcess(const BenchContext& ctx, double res)
 		return median(times);
 	};
 	double unused = 0;
-	row.ours_s = run({ctx.self, "--scaling-align", ref, "--scaling-other", other}, "SCALING ", row.ours_merged, row.ours_peak_mb);
+	row.ours_s = run(ctx.selfWith({"--scaling-align", ref, "--scaling-other", other}), "SCALING ", row.ours_merged, row.ours_peak_mb);
 	row.mrpt_s = run({ctx.self, "--mrpt-align", ref, "--scaling-other", other}, "MRPT ", row.mrpt_aligned, unused);
 	fs::remove_all(dir);
 	std::cout << "whole process " << res * 100 << " cm: ours " << row.ours_s << " s, MRPT " << row.mrpt_s << " s" << std::endl;
