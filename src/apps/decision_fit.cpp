@@ -325,6 +325,27 @@ std::string modelOf(const DecisionParams& p)
 	return out.str();
 }
 
+/** The fits, best first: every one, or the best for each runner-up weight
+ * and the kTopFits best. */
+void printFits(const std::vector<Fit>& fits, bool every)
+{
+	if (every)
+	{
+		std::cout << "every fit tried:\n";
+		for (const Fit& f : fits) std::cout << "  " << describe(f) << "\n";
+		return;
+	}
+	std::cout << "the best fit for each runner-up weight:\n";
+	for (double k : kRunnerUpWeights)
+	{
+		const auto best = std::find_if(
+			fits.begin(), fits.end(), [k](const Fit& f) { return f.params.runner_up_weight == k; });
+		if (best != fits.end()) std::cout << "  " << describe(*best) << "\n";
+	}
+	std::cout << "the " << kTopFits << " best fits (of " << fits.size() << "; --all prints every one):\n";
+	for (size_t i = 0; i < std::min(kTopFits, fits.size()); ++i) std::cout << "  " << describe(fits[i]) << "\n";
+}
+
 /** Leave one site out, as Markdown; returns the largest overshoot. Per
  * group, fitted on the pairs that do not touch it and judged on those that
  * do, two ways: the whole fit made again (how well the fitting generalizes),
@@ -474,23 +495,7 @@ int main(int argc, char** argv)
 			throw std::runtime_error(markdown_arg.getValue() + ": cannot be written");
 
 		const std::vector<Fit> final_fits = margin > kMargin ? fitGrid(pairs, {everything}, margin)[0] : fits[0];
-		if (all_arg.getValue())
-		{
-			std::cout << "every fit tried:\n";
-			for (const Fit& f : final_fits) std::cout << "  " << describe(f) << "\n";
-		}
-		else
-		{
-			std::cout << "the best fit for each runner-up weight:\n";
-			for (double k : kRunnerUpWeights)
-				std::cout << "  "
-						  << describe(*std::find_if(final_fits.begin(), final_fits.end(),
-													[k](const Fit& f) { return f.params.runner_up_weight == k; }))
-						  << "\n";
-			std::cout << "the " << kTopFits << " best fits (of " << final_fits.size() << "; --all prints every one):\n";
-			for (size_t i = 0; i < std::min(kTopFits, final_fits.size()); ++i)
-				std::cout << "  " << describe(final_fits[i]) << "\n";
-		}
+		printFits(final_fits, all_arg.getValue());
 		DecisionParams best = final_fits.front().params;
 		best.threshold = std::round(best.threshold * 1000) / 1000;  // as the ini holds it
 		std::cout << "\n" << iniOf(best);
