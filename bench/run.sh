@@ -18,17 +18,15 @@ log="${TMPDIR:-/tmp}/multires_map_merge_setup.log"
 # The decision validated leave one site out (issue 35): decision-fit on the
 # calibration samples the benchmark made (multires_bench --calibration-data;
 # bench/results/calibration_candidates*.csv), appended to the report.
-if [ ${#quick[@]} -eq 0 ]; then
-  samples=("$here"/bench/results/calibration_candidates*.csv)
-  table=$(mktemp)
-  "${BUILD_DIR:-$here/build}/devel/lib/multires_map_merge/decision-fit" --markdown "$table" "${samples[@]}" >/dev/null
-  {
-    echo
-    echo "## The decision, validated leave one site out"
-    echo
-    echo "\`decision-fit\` on the calibration samples (${#samples[@]} files: $(for s in "${samples[@]}"; do printf '`%s` ' "$(basename "$s")"; done)). The calibration pairs are grouped by the calibration site they touch (E5, HIH, the CARMEN negatives, the live fleet's growing maps, the independent ROS maps); each group is left out in turn. *Refit*: the whole fit made again without the group, judged on it. *This model*: the defaults' model with only its threshold set again without the group (its highest wrong value plus the least margin): how far a new site's wrong values rise above what the others showed, which sets the margin (docs/decision.md, Calibration). F5 and KPT4A stay out of every fit."
-    echo
-    cat "$table"
-  } >>"$out/REPORT.md"
-  rm -f "$table"
-fi
+samples=("$here"/bench/results/calibration_candidates*.csv)
+table=$(mktemp)
+trap 'rm -f "$table"' EXIT
+"${BUILD_DIR:-$here/build}/devel/lib/multires_map_merge/decision-fit" --markdown "$table" "${samples[@]}" >/dev/null
+{
+  echo
+  echo "## The decision, validated leave one site out"
+  echo
+  echo "\`decision-fit\` on the calibration samples (${#samples[@]} files: $(for s in "${samples[@]}"; do printf '`%s` ' "$(basename "$s")"; done)). The calibration pairs are grouped by the calibration site they touch (E5, HIH, the CARMEN negatives, the live fleet's growing maps, the independent ROS maps); each group is left out in turn. *Refit*: the whole fit made again without the group, judged on it. *This model*: the defaults' model with only its threshold set again without the group (its highest wrong value plus the least margin): how far a new site's wrong values rise above what the others showed, which sets the margin (docs/decision.md, Calibration). F5 and KPT4A stay out of every fit."
+  echo
+  cat "$table"
+} >>"$out/REPORT.md"

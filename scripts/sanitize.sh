@@ -23,6 +23,5 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd "$build"
 # The benchmark's runs, the memory soak (ASan's allocator is not the node's) and
 # the install test (an uninstrumented example cannot load instrumented
-# libraries) run un-instrumented in the main suite, as does the calibration
-# check (a Python fit over the committed samples, no new code paths).
-ctest --output-on-failure -E 'bench_|soak|install_|calibration_'
+# libraries) run un-instrumented in the main suite.
+ctest --output-on-failure -E 'bench_|soak|install_'

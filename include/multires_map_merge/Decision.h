@@ -2,8 +2,8 @@
 // The decision: whether two maps are merged, and how confidently, from what
 // was measured about their refined candidate transforms (MapAgreement.h,
 // FeatureHypotheses.h). Pure: no maps, no ICP, no threads. The aligner, the
-// benchmark's calibration data and the replay tool (decision-replay) call
-// this same code. Specification: docs/decision.md.
+// benchmark's calibration data, the replay tool (decision-replay) and the
+// calibration (decision-fit) call this same code. Specification: docs/decision.md.
 
 #include <multires_map_merge/Similarity2D.h>
 

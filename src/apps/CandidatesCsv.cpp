@@ -3,8 +3,10 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace multires_map_merge
 {
@@ -39,6 +41,8 @@ DecisionCandidate candidateOf(const Row& row, const std::string& where)
 {
 	DecisionCandidate c;
 	for (const auto& f : evidenceFields())
+		// A column older samples lack reads as 0 (_fit1.csv etc. have no
+		// exact_confidence: measured before it existed, as 0 would say).
 		if (row.count(f.name)) c.evidence.*f.member = number(row, f.name, where);
 	c.placement.cells = Similarity2D(number(row, "scale", where), number(row, "yaw_deg", where) * M_PI / 180, {0, 0});
 	c.placement.other_centre = {number(row, "centre_x", where), number(row, "centre_y", where)};
@@ -56,6 +60,8 @@ std::vector<CandidatePair> loadCandidatePairs(const std::string& path)
 	if (!std::getline(in, line)) throw std::runtime_error(path + ": empty");
 	const std::vector<std::string> columns = splitCsv(line);
 	std::vector<CandidatePair> pairs;
+	std::set<std::tuple<std::string, std::string, std::string>> seen;
+	bool repeated = false;  // the rows of a pair read before
 	for (size_t n = 2; std::getline(in, line); ++n)
 	{
 		const std::vector<std::string> cells = splitCsv(line);
@@ -68,11 +74,14 @@ std::vector<CandidatePair> loadCandidatePairs(const std::string& path)
 		if (pairs.empty() || pairs.back().site != row["site"] || pairs.back().ref != row["ref"] ||
 			pairs.back().other != row["other"])
 		{
+			repeated = !seen.emplace(row["site"], row["ref"], row["other"]).second;
+			if (repeated) continue;
 			CandidatePair p;
 			p.site = row["site"], p.ref = row["ref"], p.other = row["other"];
 			p.positive = row["positive"] == "1", p.calibration = row["calibration"] == "1";
 			pairs.push_back(std::move(p));
 		}
+		if (repeated) continue;
 		CandidatePair& p = pairs.back();
 		p.candidates.push_back(candidateOf(row, where));
 		p.right.push_back(row["right"] == "1");

@@ -22,7 +22,10 @@ struct CandidatePair
 };
 
 /** The pairs of a candidates file, in file order (a pair's rows are
- * adjacent). Throws naming the file, line and column on bad input. */
+ * adjacent). A pair the file holds again is the same alignment again
+ * (the benchmark's cross-site negatives in both orders both take some HIH
+ * maps as REF against E5 maps): read once. Throws naming the file, line
+ * and column on bad input. */
 std::vector<CandidatePair> loadCandidatePairs(const std::string& path);
 
 }  // namespace multires_map_merge

@@ -41,10 +41,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <functional>
 #include <fstream>
 #include <iostream>
 #include <limits>
-#include <set>
 #include <sstream>
 #include <thread>
 #include <tuple>
@@ -128,19 +129,16 @@ bool isNear(const CandidatePair& p, size_t i)
 	return p.site == "live" && !p.right[i] && std::isfinite(p.error[i]) && p.error[i] <= kLiveNearCells;
 }
 
-/** The calibration pairs of every sample. A pair a sample holds twice (the
- * benchmark's cross-site negatives in both orders both take some HIH maps
- * as REF against E5 maps) is the same alignment again: read once. */
+/** The calibration pairs of every sample. */
 std::vector<FitPair> loadCalibrationPairs(const std::vector<std::string>& paths, size_t& candidates)
 {
 	std::vector<FitPair> out;
 	candidates = 0;
 	for (size_t s = 0; s < paths.size(); ++s)
 	{
-		std::set<std::tuple<std::string, std::string, std::string>> seen;
 		for (CandidatePair& p : loadCandidatePairs(paths[s]))
 		{
-			if (!p.calibration || notFitted(p) || !seen.emplace(p.site, p.ref, p.other).second) continue;
+			if (!p.calibration || notFitted(p)) continue;
 			FitPair f;
 			f.sample = s;
 			f.kind = !p.positive ? Kind::negative : p.site == "live" ? Kind::live : Kind::positive;
@@ -254,28 +252,6 @@ bool better(const Fit& a, const Fit& b)
 	return key(a) > key(b);
 }
 
-/** Every grid point fitted on each subset, best first per subset; the
- * decisions made once per point, in parallel. */
-std::vector<std::vector<Fit>> fitGrid(const std::vector<FitPair>& pairs, const std::vector<Subset>& subsets,
-									  double margin)
-{
-	const std::vector<DecisionParams> points = grid();
-	std::vector<std::vector<Fit>> fits(subsets.size(), std::vector<Fit>(points.size()));
-	std::atomic<size_t> next{0};
-	auto work = [&] {
-		for (size_t m; (m = next++) < points.size();)
-		{
-			const std::vector<Outcome> outcomes = outcomesOf(pairs, points[m]);
-			for (size_t s = 0; s < subsets.size(); ++s) fits[s][m] = fitOn(pairs, outcomes, subsets[s], points[m], margin);
-		}
-	};
-	std::vector<std::thread> threads(std::max(1u, std::thread::hardware_concurrency()));
-	for (auto& t : threads) t = std::thread(work);
-	for (auto& t : threads) t.join();
-	for (auto& f : fits) std::sort(f.begin(), f.end(), better);
-	return fits;
-}
-
 Subset subsetOf(const std::vector<FitPair>& pairs, int group, bool touching)
 {
 	Subset in(pairs.size());
@@ -284,7 +260,51 @@ Subset subsetOf(const std::vector<FitPair>& pairs, int group, bool touching)
 	return in;
 }
 
-size_t count(const std::vector<FitPair>& pairs, const Subset& in, Kind kind)
+/** The subsets the grid is fitted on: everything, then each group left out. */
+constexpr size_t kEverything = 0;
+size_t withoutGroup(size_t g) { return 1 + g; }
+std::vector<Subset> fitSubsets(const std::vector<FitPair>& pairs)
+{
+	std::vector<Subset> subsets{subsetOf(pairs, -1, true)};
+	for (size_t g = 0; g < kGroups.size(); ++g) subsets.push_back(subsetOf(pairs, int(g), false));
+	return subsets;
+}
+
+/** Every grid point fitted on each subset, best first per subset; the
+ * decisions made once per point, in parallel. */
+std::vector<std::vector<Fit>> fitGrid(const std::vector<FitPair>& pairs, const std::vector<Subset>& subsets,
+									  double margin)
+{
+	const std::vector<DecisionParams> points = grid();
+	std::vector<std::vector<Fit>> fits(subsets.size(), std::vector<Fit>(points.size()));
+	std::atomic<size_t> next{0};
+	std::vector<std::exception_ptr> failed(std::max(1u, std::thread::hardware_concurrency()));
+	auto work = [&](std::exception_ptr& failure) {
+		try
+		{
+			for (size_t m; (m = next++) < points.size();)
+			{
+				const std::vector<Outcome> outcomes = outcomesOf(pairs, points[m]);
+				for (size_t s = 0; s < subsets.size(); ++s)
+					fits[s][m] = fitOn(pairs, outcomes, subsets[s], points[m], margin);
+			}
+		}
+		catch (...)
+		{
+			failure = std::current_exception();
+			next = points.size();
+		}
+	};
+	std::vector<std::thread> threads;
+	for (auto& failure : failed) threads.emplace_back(work, std::ref(failure));
+	for (auto& t : threads) t.join();
+	for (const auto& failure : failed)
+		if (failure) std::rethrow_exception(failure);
+	for (auto& f : fits) std::sort(f.begin(), f.end(), better);
+	return fits;
+}
+
+size_t countOf(const std::vector<FitPair>& pairs, const Subset& in, Kind kind)
 {
 	size_t n = 0;
 	for (size_t i = 0; i < pairs.size(); ++i) n += in[i] && pairs[i].kind == kind;
@@ -300,21 +320,21 @@ std::string text(double v)
 
 std::string fixed3(double v)
 {
-	char text[32];
-	std::snprintf(text, sizeof text, "%.3f", v);
-	return text;
+	char digits[32];
+	std::snprintf(digits, sizeof digits, "%.3f", v);
+	return digits;
 }
 
 std::string describe(const Fit& f)
 {
 	const DecisionParams& p = f.params;
-	char text[300];
-	std::snprintf(text, sizeof text,
+	char line[300];
+	std::snprintf(line, sizeof line,
 				  "chance_weight %4.2f evidence %4.0f features %3.1f/%2.0f runner_up_weight %4.1f floor %5.2f "
 				  "distinct %2.0f: highest wrong %.3f, threshold %.3f, merged right %zu, live %zu",
 				  p.chance_weight, p.evidence, p.feature_weight, p.feature_cap, p.runner_up_weight, p.runner_up_floor,
 				  p.distinct_shift, f.highest_wrong, p.threshold, f.merged_right, f.live_right);
-	return text;
+	return line;
 }
 
 std::string modelOf(const DecisionParams& p)
@@ -366,14 +386,14 @@ double leaveOneSiteOut(const std::vector<FitPair>& pairs, const std::vector<std:
 		// A group the data lacks, or all the data holds, cannot be left out.
 		const size_t n_train = std::count(train.begin(), train.end(), 1);
 		if (n_train == 0 || n_train == pairs.size()) continue;
-		const Fit& refit = fits[1 + g].front();
+		const Fit& refit = fits[withoutGroup(g)].front();
 		const Judgement by_refit = judge(pairs, outcomesOf(pairs, refit.params), test, refit.params.threshold);
-		const double train_highest = judge(pairs, chosen_outcomes, train, INFINITY).highest_wrong;
+		const double train_highest = judge(pairs, chosen_outcomes, train, std::numeric_limits<double>::infinity()).highest_wrong;
 		const double threshold = train_highest + kMargin * (1 + chosen.params.runner_up_weight);
 		const Judgement by_chosen = judge(pairs, chosen_outcomes, test, threshold);
 		const double over = (by_chosen.highest_wrong - train_highest) / (1 + chosen.params.runner_up_weight);
 		overshoot = std::max(overshoot, over);
-		const size_t positives = count(pairs, test, Kind::positive), negatives = count(pairs, test, Kind::negative);
+		const size_t positives = countOf(pairs, test, Kind::positive), negatives = countOf(pairs, test, Kind::negative);
 		char over_text[16];
 		std::snprintf(over_text, sizeof over_text, "%+.3f", over);
 		table << "| " << kGroups[g] << " | " << n_train << " | " << positives
@@ -404,9 +424,9 @@ std::vector<std::string> differencesFromDefaults(const DecisionParams& fit)
 	const DecisionParams defaults;
 	std::vector<std::string> differ;
 	for (const auto& f : decisionParamFields())
-		if (f.member != &DecisionParams::min_confidence && std::abs(fit.*f.member - defaults.*f.member) > 5e-4)
-			differ.push_back(std::string(f.key) + " fitted " + std::to_string(fit.*f.member) + ", default " +
-							 std::to_string(defaults.*f.member));
+		if (f.member != &DecisionParams::min_confidence && !(std::abs(fit.*f.member - defaults.*f.member) <= 5e-4))
+			differ.push_back(std::string(f.key) + " fitted " + text(fit.*f.member) + ", default " +
+							 text(defaults.*f.member));
 	return differ;
 }
 
@@ -464,29 +484,27 @@ int main(int argc, char** argv)
 		const std::vector<FitPair> pairs = loadCalibrationPairs(paths, candidates);
 		const Subset everything = subsetOf(pairs, -1, true);
 		// The threshold is set by the wrong pairs, and the fit ranked by the right ones.
-		if (!count(pairs, everything, Kind::negative) || !count(pairs, everything, Kind::positive))
+		if (!countOf(pairs, everything, Kind::negative) || !countOf(pairs, everything, Kind::positive))
 			throw std::runtime_error("the calibration pairs (calibration = 1) hold no negative or no positive pair");
 		size_t reachable = 0;
 		for (const FitPair& f : pairs)
 			reachable += f.kind == Kind::positive &&
 				std::find(f.pair.right.begin(), f.pair.right.end(), true) != f.pair.right.end();
-		std::cout << "calibration data: " << candidates << " candidates, " << count(pairs, everything, Kind::positive)
+		std::cout << "calibration data: " << candidates << " candidates, " << countOf(pairs, everything, Kind::positive)
 				  << " positive pairs (" << reachable << " with a right candidate), "
-				  << count(pairs, everything, Kind::live) << " live-fleet same-building pairs, "
-				  << count(pairs, everything, Kind::negative) << " negative pairs\n";
+				  << countOf(pairs, everything, Kind::live) << " live-fleet same-building pairs, "
+				  << countOf(pairs, everything, Kind::negative) << " negative pairs\n";
 
 		// The model fitted with the least margin, on everything and without
 		// each group; its margin validated leave one site out; the fit made
 		// again with that margin.
-		std::vector<Subset> subsets{everything};
-		for (size_t g = 0; g < kGroups.size(); ++g) subsets.push_back(subsetOf(pairs, int(g), false));
-		std::vector<std::vector<Fit>> fits = fitGrid(pairs, subsets, kMargin);
+		const std::vector<std::vector<Fit>> fits = fitGrid(pairs, fitSubsets(pairs), kMargin);
 		std::ostringstream table;
-		const double overshoot = leaveOneSiteOut(pairs, fits, fits[0].front(), table);
+		const double overshoot = leaveOneSiteOut(pairs, fits, fits[kEverything].front(), table);
 		const double margin = std::max(kMargin, overshoot);
 		char tail[200];
 		std::snprintf(tail, sizeof tail,
-					  "\nLargest overshoot of this model: %+.3f; the margin above the highest wrong value is max(%.2f, "
+					  "\nLargest overshoot of this model: %+.3f; the margin above the highest wrong value is max(%g, "
 					  "overshoot) = **%.3f** score units.\n",
 					  overshoot, kMargin, margin);
 		table << tail;
@@ -494,15 +512,16 @@ int main(int argc, char** argv)
 		if (markdown_arg.isSet() && !(std::ofstream(markdown_arg.getValue()) << table.str()))
 			throw std::runtime_error(markdown_arg.getValue() + ": cannot be written");
 
-		const std::vector<Fit> final_fits = margin > kMargin ? fitGrid(pairs, {everything}, margin)[0] : fits[0];
+		const std::vector<Fit> final_fits =
+			margin > kMargin ? fitGrid(pairs, {everything}, margin)[0] : fits[kEverything];
 		printFits(final_fits, all_arg.getValue());
-		DecisionParams best = final_fits.front().params;
+		const Fit& top = final_fits.front();
+		if (!std::isfinite(top.highest_wrong))
+			throw std::runtime_error("no calibration pair's best candidate is wrong: nothing sets the threshold");
+		DecisionParams best = top.params;
 		best.threshold = std::round(best.threshold * 1000) / 1000;  // as the ini holds it
-		std::cout << "\n" << iniOf(best);
-		std::printf("# calibration: %zu/%zu positive pairs merged right on the walls (margin %.3f x (1 + runner-up "
-					"weight) above the highest wrong value)\n",
-					final_fits.front().merged_right, count(pairs, everything, Kind::positive), margin);
-		std::fflush(stdout);
+		std::cout << "\n" << iniOf(best) << "# threshold: the margin " << fixed3(margin)
+				  << " x (1 + runner-up weight) above the highest wrong value, " << fixed3(top.highest_wrong) << "\n";
 		const size_t wrong = reportMerges(pairs, paths, best);
 		if (wrong)
 		{
