@@ -154,9 +154,10 @@ std::vector<HalmstadFleetRun> runHalmstadFleets(
 	return runs;
 }
 
-void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleetRun>& runs)
+void writeHalmstadFleetSection(
+	std::ostream& md, const std::vector<HalmstadFleetRun>& runs, const multires_map_merge::FleetParams& placed_with)
 {
-	const multires_map_merge::FleetParams fleet_defaults;
+	const multires_map_merge::FleetParams& fleet = placed_with;
 	md << "\n## Fleets of real maps (Halmstad)\n\n"
 	   << "Every sensor map of a site in one placement (`placeFleet` + `fuseFleet` in a fresh process, as "
 		  "`gridmap-merge MAP_01 … MAP_n` runs it), the first map the reference; each other map's placement is "
@@ -165,8 +166,8 @@ void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleet
 		  "0.05 m. *Tree alone*: the same pairs, each map placed through its one most confident path (joint "
 		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree at the corners of what "
 		  "the map saw by more than the tolerance of the cycle's least precise pair (`cycle_tolerance_per_rmse` ("
-	   << fleet_defaults.cycle_tolerance_per_rmse << ") × its edge RMSE, within " << fleet_defaults.cycle_tolerance_cells
-	   << "–" << fleet_defaults.maxToleranceCells() << " cells); "
+	   << fleet.cycle_tolerance_per_rmse << ") × its edge RMSE, within " << fleet.cycle_tolerance_cells
+	   << "–" << fleet.maxToleranceCells() << " cells); "
 		  "the joint refinement uses only the pairs kept. Each map's displacement and the map it was placed through "
 		  "are printed as the section runs.\n\n"
 	   << "| site | cells | right | wrong | not placed | displacement median [px] | max [px] | tree alone: right | "

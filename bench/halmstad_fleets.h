@@ -9,6 +9,8 @@
 
 #include "halmstad.h"
 
+#include <multires_map_merge/FleetMerge.h>
+
 #include <functional>
 #include <ostream>
 #include <string>
@@ -43,6 +45,7 @@ std::vector<HalmstadFleetRun> runHalmstadFleets(
 	const std::string& dir);
 
 /** The report's section: a row per fleet, tree-only beside. */
-void writeHalmstadFleetSection(std::ostream& md, const std::vector<HalmstadFleetRun>& runs);
+void writeHalmstadFleetSection(
+	std::ostream& md, const std::vector<HalmstadFleetRun>& runs, const multires_map_merge::FleetParams& placed_with);
 
 }  // namespace multires_bench

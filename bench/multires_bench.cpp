@@ -321,7 +321,8 @@ int main(int argc, char** argv)
 		}
 		if (halmstad_fleets_arg.isSet())
 		{
-			writeHalmstadFleetSection(std::cout, halmstadFleets(ctx, siteList(halmstad_fleets_arg.getValue())));
+			writeHalmstadFleetSection(std::cout, halmstadFleets(ctx, siteList(halmstad_fleets_arg.getValue())),
+									  ctx.fleet.resolvedFor(ctx.options.decision));
 			return 0;
 		}
 		if (fleet_arg.isSet())

@@ -606,7 +606,7 @@ void writeReport(const BenchContext& ctx, const std::string& out, const FullRun&
 	writeHalmstadSection(md, run, f);
 	writeScalingSection(md, run);
 	writeFleetSection(md, run.fleets);
-	if (!run.halmstad_fleets.empty()) writeHalmstadFleetSection(md, run.halmstad_fleets);
+	if (!run.halmstad_fleets.empty()) writeHalmstadFleetSection(md, run.halmstad_fleets, ctx.fleet.resolvedFor(ctx.options.decision));
 	writeLiveSection(md, run.live);
 	writeBasinSection(md, run);
 	writeTargets(md, ctx, run, f);
