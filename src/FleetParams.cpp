@@ -22,6 +22,8 @@ const std::vector<FleetParamField>& fleetParamFields()
 		 "A map placed this surely takes no more pairs; the rest are skipped"},
 		{"unsettled_tries", &F::unsettled_tries, 0, 1000, no0,
 		 "A placed map less sure than that tries this many more pairs for a surer path"},
+		{"second_path_tries", &F::second_path_tries, 0, 1000, no0,
+		 "A placed map hanging on one pair (no second path to the reference) tries this many more pairs for one"},
 		{"cycle_tolerance_cells", &F::cycle_tolerance_cells, 0.1, 1e4, no0,
 		 "Least tolerance of a cycle of pairs before its weakest pair is dropped [coarse cells]"},
 		{"cycle_tolerance_per_rmse", &F::cycle_tolerance_per_rmse, 0, 1e3, no0,

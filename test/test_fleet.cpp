@@ -133,6 +133,53 @@ TEST(Fleet, PlacesEveryRobotOfTheBuildingAndKeepsTheOtherBuildingOut)
 	EXPECT_LE(errorCoarseCells(f, 3, r.maps[3].in_reference), std::max(0.5, 1.5 * worst_direct)) << r.maps[3].message;
 }
 
+/** Whether some confident pair kept, taken out, leaves map m connected to
+ * the reference by nothing (its placement hangs on that one pair). */
+bool hangsOnOnePair(const FleetResult& r, size_t m)
+{
+	for (size_t cut = 0; cut < r.edges.size(); ++cut)
+	{
+		std::vector<bool> reached(r.maps.size(), false);
+		reached[0] = true;
+		for (bool grew = true; grew;)
+		{
+			grew = false;
+			for (size_t k = 0; k < r.edges.size(); ++k)
+			{
+				const FleetEdge& e = r.edges[k];
+				if (k == cut || !e.merged || e.dropped || reached[e.from] == reached[e.to]) continue;
+				reached[e.from] = reached[e.to] = grew = true;
+			}
+		}
+		if (!reached[m]) return true;
+	}
+	return false;
+}
+
+// With second_path_tries, a robot placed by one pair looks for a second
+// path, so a cycle checks that pair; off (the default), the two robots
+// placed directly on the reference hang on their one pair each.
+TEST(Fleet, ARobotHangingOnOnePairLooksForASecondPathWhenAsked)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const Fleet& f = *fleet();
+	const FleetResult once = placeFleet(f.maps, 0, CScalingGridMapAligner());
+	FleetParams two_paths;
+	two_paths.second_path_tries = 1;
+	const FleetResult checked = placeFleet(f.maps, 0, CScalingGridMapAligner(), two_paths);
+	// Robot 3 overlaps robot 2 alone: the data allows it one path.
+	for (size_t m : {1, 2})
+	{
+		ASSERT_TRUE(checked.maps[m].placed) << checked.maps[m].message;
+		EXPECT_FALSE(hangsOnOnePair(checked, m)) << f.robots[m].file;
+		EXPECT_LE(errorCoarseCells(f, m, checked.maps[m].in_reference), 2.0) << checked.maps[m].message;
+	}
+	EXPECT_TRUE(checked.maps[3].placed) << checked.maps[3].message;
+	EXPECT_TRUE(hangsOnOnePair(once, 1) && hangsOnOnePair(once, 2));
+	EXPECT_GT(checked.pairs_aligned, once.pairs_aligned);
+	EXPECT_FALSE(checked.maps.back().placed);  // the other building still out
+}
+
 TEST(Fleet, FusesThePlacedMapsOnTheReferenceLattice)
 {
 	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
@@ -239,6 +286,7 @@ TEST(Fleet, ParametersReadBackFromAnIniAndBadOnesAreNamed)
 {
 	FleetParams set;
 	set.threads = 3, set.settled_confidence = 0.7, set.unsettled_tries = 4, set.cycle_tolerance_cells = 2.5;
+	set.second_path_tries = 3;
 	set.cycle_tolerance_per_rmse = 6, set.cycle_tolerance_max_cells = 25, set.joint_refinement = false;
 	const std::string path = tmpDir() + "/fleet.ini";
 	{
@@ -250,6 +298,7 @@ TEST(Fleet, ParametersReadBackFromAnIniAndBadOnesAreNamed)
 	EXPECT_EQ(read.threads, 3u);
 	EXPECT_EQ(read.settled_confidence, 0.7);
 	EXPECT_EQ(read.unsettled_tries, 4u);
+	EXPECT_EQ(read.second_path_tries, 3u);
 	EXPECT_EQ(read.cycle_tolerance_cells, 2.5);
 	EXPECT_EQ(read.cycle_tolerance_per_rmse, 6);
 	EXPECT_EQ(read.cycle_tolerance_max_cells, 25);

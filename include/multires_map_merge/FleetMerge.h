@@ -68,6 +68,14 @@ struct FleetParams
 	/** A placed map not yet settled tries this many more pairs, most
 	 * promising first, for a surer path. */
 	unsigned unsettled_tries = 2;
+	/** A placed map whose placement hangs on one pair (no second path of
+	 * confident pairs to the reference: nothing checks that pair around a
+	 * cycle or refines it jointly) tries this many more pairs, most
+	 * promising first, for a second path. Off by default: on the Halmstad
+	 * fleets it aligns a third more pairs and moves no placement closer to
+	 * the annotation; a user who wants every pair the data allows checked
+	 * by a cycle pays that. */
+	unsigned second_path_tries = 0;
 	/** A cycle whose composed transform moves the corners of what a map saw
 	 * by more than its tolerance (cells of the coarser map, RMS) is
 	 * contradictory. A pair's tolerance follows its precision:
