@@ -5,6 +5,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <Eigen/Sparse>
 
 #include <algorithm>
 #include <cmath>
@@ -96,6 +97,50 @@ const HalmstadPair* HalmstadData::pair(const std::string& src, const std::string
 {
 	auto it = pairs_.find({src, dst});
 	return it == pairs_.end() ? nullptr : &it->second;
+}
+
+std::vector<Similarity2D> HalmstadData::jointlyToFirst(const std::vector<std::string>& maps) const
+{
+	// Map k's pixels z go to the first map's as a_k·z + b_k (complex a, b:
+	// four unknowns, linear); each correspondence (s of src, d of dst) asks
+	// a_src·s + b_src = a_dst·d + b_dst. The first map is the identity.
+	const size_t n = maps.size();
+	std::vector<Eigen::Triplet<double>> a;
+	std::vector<double> rhs;
+	auto add = [&](size_t map, const Eigen::Vector2d& z, double sign, size_t row) {
+		if (map == 0)  // fixed: the identity moves to the right-hand side
+		{
+			rhs[row] -= sign * z.x(), rhs[row + 1] -= sign * z.y();
+			return;
+		}
+		const int c = int(4 * (map - 1));
+		a.emplace_back(int(row), c, sign * z.x()), a.emplace_back(int(row), c + 1, -sign * z.y());
+		a.emplace_back(int(row), c + 2, sign);
+		a.emplace_back(int(row + 1), c, sign * z.y()), a.emplace_back(int(row + 1), c + 1, sign * z.x());
+		a.emplace_back(int(row + 1), c + 3, sign);
+	};
+	for (size_t i = 0; i < n; ++i)
+		for (size_t j = i + 1; j < n; ++j)
+			if (const HalmstadPair* p = pair(maps[i], maps[j]))
+				for (const auto& [s, d] : p->inliers)
+				{
+					const size_t row = rhs.size();
+					rhs.resize(row + 2, 0.0);
+					add(i, s, +1, row), add(j, d, -1, row);
+				}
+	Eigen::SparseMatrix<double> m(int(rhs.size()), int(4 * (n - 1)));
+	m.setFromTriplets(a.begin(), a.end());
+	const Eigen::SparseMatrix<double> normal = m.transpose() * m;
+	Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+	const Eigen::VectorXd x = solver.solve(m.transpose() * Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size()));
+	if (solver.info() != Eigen::Success) throw std::runtime_error("the annotations do not connect every map");
+	std::vector<Similarity2D> out{Similarity2D()};
+	for (size_t k = 1; k < n; ++k)
+	{
+		const double ar = x[4 * (k - 1)], ai = x[4 * (k - 1) + 1];
+		out.emplace_back(std::hypot(ar, ai), std::atan2(ai, ar), Eigen::Vector2d(x[4 * (k - 1) + 2], x[4 * (k - 1) + 3]));
+	}
+	return out;
 }
 
 std::vector<HalmstadPair> HalmstadData::unorderedPairs(const std::string& site) const
@@ -191,23 +236,64 @@ Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, 
 	return betweenMapFrames(ref, cellToMetric(ref.grid).compose(cells).compose(cellToMetric(other.grid).inverse()), other);
 }
 
+double meanDisplacementPx(const Similarity2D& est, const Similarity2D& truth_px, const GridInFrame& other, int ref_rows)
+{
+	if (!est.isFinite()) return NAN;
+	const int src_rows = static_cast<int>(other.grid.getSizeY());
+	std::vector<cv::Point> occupied;
+	cv::findNonZero(toClassImage(other.grid) == kOccupied, occupied);
+	double sum = 0;
+	for (const auto& c : occupied)
+	{
+		// Class images have row = cy (y up): pixel v = rows − 1 − cy.
+		const Eigen::Vector2d px(c.x, src_rows - 1 - c.y);
+		sum += (metricToPx(est(pxToMetric(px, src_rows)), ref_rows) - truth_px(px)).norm();
+	}
+	return occupied.empty() ? NAN : sum / occupied.size();
+}
+
+namespace
+{
+/** The pixels of a map's occupied cells (u, v from the top). */
+std::vector<Eigen::Vector2d> occupiedPx(const GridInFrame& map)
+{
+	std::vector<cv::Point> occupied;
+	cv::findNonZero(toClassImage(map.grid) == kOccupied, occupied);
+	std::vector<Eigen::Vector2d> out;
+	const int rows = static_cast<int>(map.grid.getSizeY());
+	for (const auto& c : occupied) out.emplace_back(c.x, rows - 1 - c.y);  // class images have y up
+	return out;
+}
+}  // namespace
+
+double annotationDisagreementPx(
+	const HalmstadData& data, const std::vector<std::string>& maps, const std::vector<GridInFrame>& loaded)
+{
+	std::vector<double> disagreement;
+	for (size_t k = 1; k < maps.size(); ++k)
+	{
+		const HalmstadPair* direct = data.pair(maps[k], maps[0]);
+		if (!direct) continue;
+		const std::vector<Eigen::Vector2d> px = occupiedPx(loaded[k]);
+		for (size_t j = 1; j < maps.size(); ++j)
+		{
+			const HalmstadPair *to_j = data.pair(maps[k], maps[j]), *j_to_ref = data.pair(maps[j], maps[0]);
+			if (j == k || !to_j || !j_to_ref || px.empty()) continue;
+			const Similarity2D chain = j_to_ref->src_to_dst_px.compose(to_j->src_to_dst_px);
+			double sum = 0;
+			for (const auto& p : px) sum += (chain(p) - direct->src_to_dst_px(p)).norm();
+			disagreement.push_back(sum / px.size());
+		}
+	}
+	return median(disagreement);
+}
+
 HalmstadOutcome judge(const Similarity2D& est, const HalmstadPair& p, const GridInFrame& other, int ref_rows)
 {
 	HalmstadOutcome o;
 	if (!est.isFinite()) return o;
 	const int src_rows = static_cast<int>(other.grid.getSizeY());
-	std::vector<cv::Point> occupied;
-	cv::findNonZero(toClassImage(other.grid) == kOccupied, occupied);
-	double sum = 0;
-	size_t n = 0;
-	for (const auto& c : occupied)
-	{
-		// Class images have row = cy (y up): pixel v = rows − 1 − cy.
-		const Eigen::Vector2d px(c.x, src_rows - 1 - c.y);
-		const Eigen::Vector2d q_est = metricToPx(est(pxToMetric(px, src_rows)), ref_rows);
-		sum += (q_est - p.src_to_dst_px(px)).norm(), ++n;
-	}
-	if (n) o.mean_displacement_px = sum / n;
+	o.mean_displacement_px = meanDisplacementPx(est, p.src_to_dst_px, other, ref_rows);
 	double se = 0;
 	for (const auto& [s, d] : p.inliers)
 		se += (metricToPx(est(pxToMetric(s, src_rows)), ref_rows) - d).squaredNorm();

@@ -23,6 +23,8 @@ struct FleetPlacing
 {
 	size_t right = 0, wrong = 0, not_placed = 0;
 	std::vector<double> displacement_px;  //!< per map placed (mean over its occupied pixels)
+	/** The same against every annotated pair at once (HalmstadData::jointlyToFirst). */
+	std::vector<double> displacement_joint_truth_px;
 };
 
 struct HalmstadFleetRun
@@ -32,6 +34,7 @@ struct HalmstadFleetRun
 	size_t maps = 0, pairs_aligned = 0, pairs_skipped = 0;
 	size_t pairs_confident = 0, pairs_dropped = 0;  //!< dropped: contradicted a cycle (not used by the placement)
 	double seconds = 0, peak_mb = 0;  //!< the whole child process's placement and fusion
+	double annotation_disagreement_px = NAN;  //!< annotationDisagreementPx of the site's maps
 	FleetPlacing joint, tree;  //!< placeFleet as it is; the spanning tree alone
 };
 
