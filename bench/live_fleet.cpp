@@ -113,12 +113,15 @@ bool LiveLatency::met() const
 	return true;
 }
 
-LiveLatency runLiveLatency(const ScansOf& scans, int states)
+LiveLatency runLiveLatency(
+	const ScansOf& scans, int states, const CScalingGridMapAligner::TConfigParams& aligner, const FleetParams& fleet)
 {
 	LiveLatency out;
 	out.states = states;
 	const auto& robots = liveRobots();
 	ros1::LiveFleetParams params;  // as the node sets them at its default rate
+	params.aligner = aligner;
+	params.placement = fleet;
 	params.estimation_budget_s = ros1::defaultEstimationBudget(1.0 / out.period_s);
 	out.budget_s = params.estimation_budget_s;
 	ros1::LiveFleet live(params);

@@ -5,6 +5,7 @@
 // *can* be merged (placeFleet on those maps, offline). Robots of fr079 at
 // 5 / 3 / 8 cm in their own frames and one of intel (another building).
 
+#include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <nav_msgs/OccupancyGrid.h>
 
@@ -73,8 +74,11 @@ std::vector<LiveMap> liveMapsAt(const ScansOf& scans, int state, int states);
 /** The map_merge node on a simulated clock: every `state_s` seconds each
  * robot's map grows by 1/`states` of its share of the run; an estimation
  * starts every period (or when the previous one ends, if later), sees the
- * latest maps, and takes what it measures on this machine. */
-LiveLatency runLiveLatency(const ScansOf& scans, int states);
+ * latest maps, and takes what it measures on this machine; the live fleet
+ * runs `aligner` and `fleet` (the defaults, or --config's). */
+LiveLatency runLiveLatency(
+	const ScansOf& scans, int states, const multires_map_merge::CScalingGridMapAligner::TConfigParams& aligner,
+	const multires_map_merge::FleetParams& fleet);
 
 void writeLiveSection(std::ostream& md, const LiveLatency& l);
 

@@ -103,7 +103,7 @@ int negativesOnly(const BenchContext& ctx)
 
 int liveOnly(const BenchContext& ctx)
 {
-	const LiveLatency live = runLiveLatency(carmenScans(ctx), ctx.quick ? 4 : 16);
+	const LiveLatency live = runLiveLatency(carmenScans(ctx), ctx.quick ? 4 : 16, ctx.options, ctx.fleet);
 	writeLiveSection(std::cout, live);
 	// Exit 1 when a robot was ever placed wrong (the other building at
 	// all); its latency depends on this machine's speed and is only shown.
@@ -183,7 +183,7 @@ void runCostFleetsAndBasin(const BenchContext& ctx, FullRun& run)
 		run.processes.push_back(runWholeProcess(ctx, r));
 	run.fleets = runFleets(ctx);
 	if (!quick) run.halmstad_fleets = halmstadFleets(ctx, HalmstadData(ctx.data + "/halmstad").sites());
-	run.live = runLiveLatency(carmenScans(ctx), quick ? 4 : 16);
+	run.live = runLiveLatency(carmenScans(ctx), quick ? 4 : 16, ctx.options, ctx.fleet);
 	run.basin_dyaws = quick ? std::vector<double>{-8, 0, 8} : std::vector<double>{-8, -6, -4, -2, 0, 2, 4, 6, 8};
 	run.basin_dscales = run.basin_dyaws;  // percent
 	run.basin_same = basin(ctx, "fr079", 0.05, 0.05, run.basin_dyaws, run.basin_dscales);
@@ -328,7 +328,7 @@ int main(int argc, char** argv)
 		if (fleet_arg.isSet())
 		{
 			writeFleetSection(std::cout, runFleets(ctx));
-			writeLiveSection(std::cout, runLiveLatency(carmenScans(ctx), ctx.quick ? 4 : 16));
+			writeLiveSection(std::cout, runLiveLatency(carmenScans(ctx), ctx.quick ? 4 : 16, ctx.options, ctx.fleet));
 			return 0;
 		}
 		return fullRun(ctx, out);
