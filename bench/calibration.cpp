@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -134,18 +135,25 @@ void runFloorPlanCalibrationPairs(const BenchContext& ctx, const HalmstadData& d
 /** Calibration negatives in the other order: each map of another site as
  * REF against `per_map` E5 maps as OTHER. The decision is not symmetric in
  * its maps, and the report's cross-site negatives take every site's maps as
- * REF; runHalmstad's calibration negatives take only E5 and HIH maps. */
+ * REF; runHalmstad's calibration negatives take only E5 and HIH maps. A
+ * pair those made already (an HIH map as REF, an E5 map) is not made again. */
 void runReverseCrossSiteNegatives(const BenchContext& ctx, const HalmstadData& data, size_t per_map)
 {
 	const std::string dir = ctx.tempDir("reverse");
 	const std::vector<std::string> e5 = data.sensorMaps("E5");
+	const auto made = crossSiteNegatives(data, {"E5", "HIH"}, per_map);
 	for (const auto& site : data.sites())
 		if (site != "E5")
 			for (const auto& ref : data.sensorMaps(site))
 			{
 				// Spread over the E5 maps from a per-map offset, as runHalmstad's.
 				const size_t start = std::hash<std::string>()(ref) % e5.size();
-				for (size_t k = 0; k < per_map; ++k) runHalmstadPair(ctx, data, ref, e5[(start + k * 5) % e5.size()], dir);
+				for (size_t k = 0; k < per_map; ++k)
+				{
+					const std::pair<std::string, std::string> pair{ref, e5[(start + k * 5) % e5.size()]};
+					if (std::find(made.begin(), made.end(), pair) == made.end())
+						runHalmstadPair(ctx, data, pair.first, pair.second, dir);
+				}
 			}
 	fs::remove_all(dir);
 }

@@ -102,29 +102,35 @@ std::vector<HalmstadRun> runHalmstad(
 		for (const auto& p : data.unorderedPairs(site))
 			runs.push_back(runHalmstadPair(ctx, data, p.dst, p.src, dir, k++ % 16 == 0 ? 30.0 : 0.0));
 	}
-	if (negatives_per_map)
-	{
-		std::vector<std::string> all;
-		for (const auto& site : data.sites())
-			for (const auto& m : data.sensorMaps(site)) all.push_back(m);
-		for (const auto& site : sites)
-			for (const auto& ref : data.sensorMaps(site))
-			{
-				size_t taken = 0;
-				// Walk the other sites' maps from a per-map offset, so the
-				// negatives spread over every site and map.
-				const size_t start = std::hash<std::string>()(ref) % all.size();
-				for (size_t k = 0; k < all.size() && taken < negatives_per_map; ++k)
-				{
-					const std::string& other = all[(start + k * 7) % all.size()];
-					if (siteOf(other) == site) continue;
-					runs.push_back(runHalmstadPair(ctx, data, ref, other, dir));
-					++taken;
-				}
-			}
-	}
+	for (const auto& [ref, other] : crossSiteNegatives(data, sites, negatives_per_map))
+		runs.push_back(runHalmstadPair(ctx, data, ref, other, dir));
 	fs::remove_all(dir);
 	return runs;
+}
+
+std::vector<std::pair<std::string, std::string>> crossSiteNegatives(
+	const HalmstadData& data, const std::vector<std::string>& sites, size_t per_map)
+{
+	std::vector<std::string> all;
+	for (const auto& site : data.sites())
+		for (const auto& m : data.sensorMaps(site)) all.push_back(m);
+	std::vector<std::pair<std::string, std::string>> out;
+	for (const auto& site : sites)
+		for (const auto& ref : data.sensorMaps(site))
+		{
+			size_t taken = 0;
+			// Walk the other sites' maps from a per-map offset, so the
+			// negatives spread over every site and map.
+			const size_t start = std::hash<std::string>()(ref) % all.size();
+			for (size_t k = 0; k < all.size() && taken < per_map; ++k)
+			{
+				const std::string& other = all[(start + k * 7) % all.size()];
+				if (siteOf(other) == site) continue;
+				out.emplace_back(ref, other);
+				++taken;
+			}
+		}
+	return out;
 }
 
 }  // namespace multires_bench

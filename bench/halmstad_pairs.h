@@ -49,6 +49,12 @@ HalmstadRun runHalmstadPair(
 	const BenchContext& ctx, const HalmstadData& data, const std::string& ref, const std::string& other,
 	const std::string& dir, double mrpt_limit_s = 0);
 
+/** The cross-site negatives of `sites` (REF, OTHER): each of their maps as
+ * REF against `per_map` maps of the other sites, spread over every site and
+ * map. */
+std::vector<std::pair<std::string, std::string>> crossSiteNegatives(
+	const HalmstadData& data, const std::vector<std::string>& sites, size_t per_map);
+
 /** The issue's pair sets: every unordered same-site pair (REF = the later
  * map), and cross-site negatives: each map of one site against maps of the
  * others, `negatives_per_map` each. */

@@ -23,8 +23,8 @@ struct CandidatePair
 
 /** The pairs of a candidates file, in file order (a pair's rows are
  * adjacent). A pair the file holds again is the same alignment again
- * (the benchmark's cross-site negatives in both orders both take some HIH
- * maps as REF against E5 maps): read once. Throws naming the file, line
+ * (samples made before the benchmark stopped making some HIH-REF × E5
+ * negatives twice hold them twice): read once. Throws naming the file, line
  * and column on bad input. */
 std::vector<CandidatePair> loadCandidatePairs(const std::string& path);
 
