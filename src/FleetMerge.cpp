@@ -333,40 +333,7 @@ struct FleetProgress
 	const std::set<PairKey>& tried;
 	/** Pairs aligned for each map since it was placed, looking for another path. */
 	const std::vector<size_t>& tries_since_placed;
-	/** Per map: its placement hangs on one pair (hangsOnOnePair). */
-	const std::vector<bool>& on_one_pair;
 };
-
-/** Per map: whether its placement hangs on one pair, i.e. one confident pair
- * kept, taken out, leaves it connected to the reference by nothing (a
- * bridge). Then no second, independent path checks it around a cycle or
- * refines it jointly: a wrong or imprecise pair would go unseen. */
-std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
-{
-	const size_t n = f.maps.size();
-	std::vector<size_t> kept;
-	for (size_t k = 0; k < f.edges.size(); ++k)
-		if (f.edges[k].merged && !f.edges[k].dropped) kept.push_back(k);
-	std::vector<bool> out(n, false);
-	for (size_t cut : kept)
-	{
-		std::vector<bool> reached(n, false);
-		reached[reference] = true;
-		for (bool grew = true; grew;)
-		{
-			grew = false;
-			for (size_t k : kept)
-			{
-				const FleetEdge& e = f.edges[k];
-				if (k == cut || reached[e.from] == reached[e.to]) continue;
-				reached[e.from] = reached[e.to] = true;
-				grew = true;
-			}
-		}
-		for (size_t m = 0; m < n; ++m) out[m] = out[m] || (f.maps[m].placed && !reached[m]);
-	}
-	return out;
-}
 
 /** Whether map m still wants pairs: not placed; or placed less surely than
  * settled, or hanging on one pair, and not yet given that many more pairs
@@ -378,7 +345,7 @@ bool wantsPairs(size_t m, size_t reference, const FleetProgress& f, const FleetP
 	if (!p.placed) return true;
 	const size_t tries = f.tries_since_placed[m];
 	if (p.confidence < params.settled_confidence && tries < params.unsettled_tries) return true;
-	return f.on_one_pair[m] && tries < params.second_path_tries;
+	return !p.checked_by_cycle && tries < params.second_path_tries;
 }
 
 /** The next round: each map that wants pairs takes its most promising one
@@ -420,6 +387,37 @@ PairList nextPairs(
 	}
 }
 
+/** Per map: whether its placement hangs on one pair, i.e. one confident pair
+ * kept, taken out, leaves it connected to the reference by nothing (a
+ * bridge). Then no second, independent path checks it around a cycle or
+ * refines it jointly: a wrong or imprecise pair would go unseen. */
+std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
+{
+	const size_t n = f.maps.size();
+	std::vector<size_t> kept;
+	for (size_t k = 0; k < f.edges.size(); ++k)
+		if (f.edges[k].merged && !f.edges[k].dropped) kept.push_back(k);
+	std::vector<bool> out(n, false);
+	for (size_t cut : kept)
+	{
+		std::vector<bool> reached(n, false);
+		reached[reference] = true;
+		for (bool grew = true; grew;)
+		{
+			grew = false;
+			for (size_t k : kept)
+			{
+				const FleetEdge& e = f.edges[k];
+				if (k == cut || reached[e.from] == reached[e.to]) continue;
+				reached[e.from] = reached[e.to] = true;
+				grew = true;
+			}
+		}
+		for (size_t m = 0; m < n; ++m) out[m] = out[m] || (f.maps[m].placed && !reached[m]);
+	}
+	return out;
+}
+
 /** Each map's content corners, from its prepared class image where it has one. */
 std::vector<ContentCorners> contentCornersOf(const std::vector<GridInFrame>& maps, const PreparedMaps& prepared = {})
 {
@@ -449,6 +447,10 @@ FleetResult placeFromPairs(
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
 	}
+	const std::vector<bool> on_one_pair = hangsOnOnePair(out, reference);
+	for (size_t m = 0; m < maps.size(); ++m)
+		if (m != reference && out.maps[m].placed && !on_one_pair[m])
+			out.maps[m].checked_by_cycle = true, out.maps[m].message += ", checked by a cycle";
 	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		if (out.maps[m].placed) continue;
@@ -569,8 +571,7 @@ FleetResult placeFleet(
 		}
 		out = placeFromPairs(maps, corners, reference, edges, params);
 		edges = out.edges;  // with the dropped marks
-		const std::vector<bool> on_one_pair = hangsOnOnePair(out, reference);
-		todo = nextPairs(reference, {out, done, tries_since_placed, on_one_pair}, promise, params, params.threads);
+		todo = nextPairs(reference, {out, done, tries_since_placed}, promise, params, params.threads);
 	}
 	out.pairs_aligned = pairs_aligned;
 	out.pairs_reused = pairs_reused;

@@ -70,6 +70,7 @@ std::string fleetJson(
 			{"transform", p.placed ? transformJson(p.in_reference) : nlohmann::ordered_json()},
 			{"confidence", num(p.confidence)},
 			{"placed_through", p.parent >= 0 && size_t(p.parent) != reference ? name(p.parent) : ""},
+			{"checked_by_cycle", p.checked_by_cycle},
 			{"error", p.placed ? "" : p.message},
 		});
 	}

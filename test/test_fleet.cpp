@@ -176,6 +176,10 @@ TEST(Fleet, ARobotHangingOnOnePairLooksForASecondPathWhenAsked)
 	}
 	EXPECT_TRUE(checked.maps[3].placed) << checked.maps[3].message;
 	EXPECT_TRUE(hangsOnOnePair(once, 1) && hangsOnOnePair(once, 2));
+	// What each placement reports says the same.
+	for (const FleetResult* r : {&once, &checked})
+		for (size_t m = 1; m < r->maps.size(); ++m)
+			EXPECT_EQ(r->maps[m].checked_by_cycle, r->maps[m].placed && !hangsOnOnePair(*r, m)) << f.robots[m].file;
 	EXPECT_GT(checked.pairs_aligned, once.pairs_aligned);
 	EXPECT_FALSE(checked.maps.back().placed);  // the other building still out
 }

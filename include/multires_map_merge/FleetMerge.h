@@ -54,6 +54,10 @@ struct FleetPlacement
 	/** The weakest edge on its path (1 for the reference itself). */
 	double confidence = 0;
 	int parent = -1;  //!< the map it was placed through (-1: reference or none)
+	/** A second path of confident pairs kept reaches the reference: no one
+	 * pair, taken out, leaves this map unconnected, so a cycle checked every
+	 * pair it was placed by. False: it hangs on one pair. */
+	bool checked_by_cycle = false;
 	std::string message;  //!< how it was placed, or why not
 };
 
@@ -73,8 +77,10 @@ struct FleetParams
 	 * cycle or refines it jointly) tries this many more pairs, most
 	 * promising first, for a second path. Off by default: on the Halmstad
 	 * fleets it aligns a third more pairs and moves no placement closer to
-	 * the annotation; a user who wants every pair the data allows checked
-	 * by a cycle pays that. */
+	 * the annotation, and on renderings of one log (the fleet test) the
+	 * extra pairs pull a chained map half a cell farther; a user who wants
+	 * every pair the data allows checked by a cycle pays that. Each
+	 * placement says whether it was (FleetPlacement::checked_by_cycle). */
 	unsigned second_path_tries = 0;
 	/** A cycle whose composed transform moves the corners of what a map saw
 	 * by more than its tolerance (cells of the coarser map, RMS) is

@@ -126,7 +126,8 @@ int mergeFleet(
 		const double implied = in.maps[m].grid.getResolution() * p.in_reference.scale;
 		finest = std::min(finest, implied);
 		std::cout << "placed " << in.names[m] << " (confidence " << p.confidence
-				  << (p.parent > 0 ? ", through " + in.names[p.parent] : std::string()) << "): x "
+				  << (p.parent > 0 ? ", through " + in.names[p.parent] : std::string())
+				  << (p.checked_by_cycle ? ", checked by a cycle" : "") << "): x "
 				  << p.in_reference.t.x() << " m, y " << p.in_reference.t.y() << " m, yaw "
 				  << p.in_reference.yaw * 180 / M_PI << " deg, scale " << p.in_reference.scale
 				  << "; implied resolution " << implied << " m\n";
