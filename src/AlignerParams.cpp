@@ -40,6 +40,9 @@ const std::vector<AlignerParamField>& alignerParamFields()
 		{"mirror_check", &P::mirror_check, 0, 1, no0,
 		 "Before merging on the walls, align the other map mirrored too: its candidates are rivals, so a mirror "
 		 "image is refused"},
+		{"both_orders", &P::both_orders, 0, 1, no0,
+		 "A pair refused one way round is aligned the other way round too (REF onto OTHER) and merged if that is "
+		 "confident"},
 		// TsICP (TsICP.h)
 		{"xi_min", &P::xi_min, 0.05, 1, no0, "TsICP: the smallest overlap share it may choose"},
 		{"lambda", &P::lambda, 0, 100, no0, "TsICP: overlap preference, psi = e/xi^(1+lambda)"},

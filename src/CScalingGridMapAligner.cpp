@@ -105,12 +105,6 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignGrids(
 }
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
-	const TPreparedMap& ref, const TPreparedMap& other) const
-{
-	return align(ref, other, std::nullopt);
-}
-
-CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	const TPreparedMap& ref, const TPreparedMap& other, const Similarity2D& start_metric) const
 {
 	return align(ref, other, start_metric);
@@ -170,6 +164,50 @@ void report(
 	info.objective_history = r.objective_history;
 }
 }  // namespace
+
+namespace
+{
+/** A result of `other` ← `ref` (the maps' roles swapped) as `ref` ← `other`. */
+CScalingGridMapAligner::TReturnInfo swappedBack(
+	CScalingGridMapAligner::TReturnInfo r, const PreparedMap& ref, const PreparedMap& other)
+{
+	r.roles_swapped = true;
+	r.cells = r.cells.inverse();
+	r.initial_cells = r.initial_cells.inverse();
+	r.metric = r.metric.inverse();
+	r.implied_resolution_other = r.cells.scale * ref.resolution;
+	std::swap(r.ref_edge_points, r.other_edge_points);
+	for (auto& c : r.candidates)
+	{
+		c.cells = c.cells.inverse(), c.initial_cells = c.initial_cells.inverse();
+		c.other_centre = c.cells.apply(other.wall_centroid);
+	}
+	return r;
+}
+}  // namespace
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
+	const TPreparedMap& ref, const TPreparedMap& other) const
+{
+	TReturnInfo info = align(ref, other, std::nullopt);
+	if (info.success || !options.both_orders || options.exhaustive_search ||
+		!inputProblem(options, ref, other).empty())
+		return info;
+	TReturnInfo swapped = align(other, ref, std::nullopt);
+	for (const auto& [name, seconds] : info.stage_seconds) swapped.stage_seconds[name] += seconds;
+	swapped.executionTime += info.executionTime;
+	if (swapped.success)
+	{
+		MRPT_LOG_INFO("merged with the maps' roles swapped (the reference aligned onto the other map)");
+		return swappedBack(std::move(swapped), ref, other);
+	}
+	std::ostringstream why;
+	why << info.message << "; the other way round not either (confidence " << swapped.confidence << ")";
+	info.message = why.str();
+	info.stage_seconds = swapped.stage_seconds;
+	info.executionTime = swapped.executionTime;
+	return info;
+}
 
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const

@@ -44,6 +44,7 @@ std::string toJson(const CScalingGridMapAligner::TReturnInfo& r, double runtime_
 		{"runner_up_score", num(r.runner_up_score)},
 		{"decision_value", num(r.decision_value)},
 		{"mirror_score", num(r.mirror_score)},
+		{"roles_swapped", r.roles_swapped},
 		{"confidence", num(r.confidence)},
 		{"icp_iterations", r.icp_iterations},
 		{"runtime_s", num(runtime_s)},

@@ -77,6 +77,15 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * flipped map, fits at least as well mirrored and is refused
 		 * (TReturnInfo::mirror_score). */
 		bool mirror_check = true;
+		/** A pair refused with OTHER aligned onto REF is aligned once more the
+		 * other way round (REF onto OTHER) and merged if that is confident,
+		 * its transforms inverted (TReturnInfo::roles_swapped): the search is
+		 * not symmetric in the maps (OTHER's features are matched into REF,
+		 * the structure search moves OTHER), and which map a user names first
+		 * should not decide the merge. The decision was calibrated on pairs
+		 * in both orders. Not with a start (tracking) nor exhaustive_search
+		 * (calibration data makes each order a pair of its own). */
+		bool both_orders = true;
 		// --- TsICP
 		double xi_min = 0.35;
 		double lambda = 2.0;
@@ -210,6 +219,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** A given start was confident: no global search ran (alignScaled with
 		 * a start). */
 		bool tracked = false;
+		/** Merged by REF aligned onto OTHER (both_orders): every number is
+		 * that alignment's, its transforms and candidates inverted into this
+		 * pair's order. */
+		bool roles_swapped = false;
 		std::string message;  //!< why not, when not
 		/** x_ref = metric(x_other), metres, each map read with its stated metadata. */
 		Similarity2D metric;
