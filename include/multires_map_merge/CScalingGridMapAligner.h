@@ -81,11 +81,13 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * other way round (REF onto OTHER) and merged if that is confident,
 		 * its transforms inverted (TReturnInfo::roles_swapped): the search is
 		 * not symmetric in the maps (OTHER's features are matched into REF,
-		 * the structure search moves OTHER), and which map a user names first
-		 * should not decide the merge. The decision was calibrated on pairs
-		 * in both orders. Not with a start (tracking) nor exhaustive_search
-		 * (calibration data makes each order a pair of its own). */
-		bool both_orders = true;
+		 * the structure search moves OTHER). Off by default: the calibration
+		 * has sensor pairs in both orders but a coarser map only as OTHER,
+		 * and as REF it merged E5_11 ← E5_05 recorded 3.3× coarser 912 px
+		 * off (docs/decision.md). Not with a start (tracking) nor
+		 * exhaustive_search (calibration data makes each order a pair of its
+		 * own). */
+		bool both_orders = false;
 		// --- TsICP
 		double xi_min = 0.35;
 		double lambda = 2.0;
