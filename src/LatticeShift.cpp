@@ -31,6 +31,30 @@ size_t mismatch(
 	}
 	return seen_count - hits + extra;
 }
+
+/** The whole-cell shift in [-1, 1]² that leaves the least mismatch, (0, 0)
+ * unless another leaves strictly less. Maps that coincide cell for cell fit
+ * exactly on part of their points a cell off too: where walls are two cells
+ * thick, one face lands on the other and the fit's error there is zero, so
+ * a trimmed fit settles on half the points (ψ = 0) as readily as on all of
+ * them. The cells the shifted points fill tell the two apart. */
+Eigen::Vector2d wholeCellSlip(
+	const PointList& fine, const cv::Mat& seen, const cv::Mat& near_known, size_t seen_count)
+{
+	cv::Mat stamp = cv::Mat::zeros(near_known.size(), CV_32S);
+	Eigen::Vector2d best(0, 0);
+	size_t least = mismatch(fine, best, seen, near_known, seen_count, stamp, 1);
+	int id = 1;
+	for (int dy = -1; dy <= 1; ++dy)
+		for (int dx = -1; dx <= 1; ++dx)
+		{
+			if (dx == 0 && dy == 0) continue;
+			const Eigen::Vector2d shift(dx, dy);
+			if (const size_t cost = mismatch(fine, shift, seen, near_known, seen_count, stamp, ++id); cost < least)
+				least = cost, best = shift;
+		}
+	return best;
+}
 }  // namespace
 
 Eigen::Vector2d latticeShift(
@@ -46,7 +70,7 @@ Eigen::Vector2d latticeShift(
 	// Two passes: the whole range at four steps, then around its answer.
 	// Steps bounded below: the work grows with (range / step)².
 	const double finest = std::max(p.step, p.range / 100);
-	Eigen::Vector2d centre(0, 0);
+	Eigen::Vector2d centre = wholeCellSlip(fine_in_coarse, seen, coarse_near_known, coarse_seen.size());
 	double half = p.range, step = std::max(finest, p.range / 10);
 	for (int pass = 0; pass < 2; ++pass)
 	{

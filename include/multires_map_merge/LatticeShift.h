@@ -29,7 +29,9 @@ struct LatticeShiftParams
  * occupied cells the finer map sees) and nothing else the coarse map knows.
  * `coarse_near_known` (CV_8U, non-zero where known) is what it knows grown by
  * two cells (knownWithin), so that walls at the edge of what it saw count.
- * Searched coarse to fine. */
+ * Searched coarse to fine, after the best whole-cell shift within one cell
+ * (maps that coincide cell for cell can also fit exactly a cell off on half
+ * their points, where walls are two cells thick). */
 Eigen::Vector2d latticeShift(
 	const PointList& fine_in_coarse, const PointList& coarse_seen, const cv::Mat& coarse_near_known,
 	const LatticeShiftParams& p = {});

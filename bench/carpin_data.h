@@ -1,0 +1,59 @@
+#pragma once
+// Carpin's map-merging test maps (../shared/data/carpin_mapmerge, SOURCES.md
+// 4): gzipped text, one grid row per line, top row first, 0 occupied, 127
+// unknown, 255 free. Those are map_server's own PGM values, so each map is
+// written as a map_server file and read back as a user would feed it. The
+// cell size is not stated (about 5 cm for the Intel lab): 5 cm. The
+// benchmark's section (carpin_maps.h) and test_real_maps read them so.
+
+#include <mrpt/io/zip.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace multires_map_merge::carpin
+{
+/** The grid as an 8-bit image, top row first; throws naming the file. */
+inline cv::Mat readGrid(const std::string& txt_gz)
+{
+	std::vector<uint8_t> bytes;
+	if (!mrpt::io::zip::decompress_gz_file(txt_gz, bytes)) throw std::runtime_error("'" + txt_gz + "': unreadable");
+	std::istringstream text(std::string(bytes.begin(), bytes.end()));
+	std::vector<std::vector<uint8_t>> rows;
+	for (std::string line; std::getline(text, line);)
+	{
+		std::istringstream values(line);
+		std::vector<uint8_t> row;
+		for (int v; values >> v;)
+		{
+			if (v < 0 || v > 255) throw std::runtime_error("'" + txt_gz + "': value outside 0..255");
+			row.push_back(uint8_t(v));
+		}
+		if (row.empty()) continue;
+		if (!rows.empty() && row.size() != rows.front().size())
+			throw std::runtime_error("'" + txt_gz + "': rows of different lengths");
+		rows.push_back(std::move(row));
+	}
+	if (rows.empty()) throw std::runtime_error("'" + txt_gz + "': no grid");
+	cv::Mat image(int(rows.size()), int(rows.front().size()), CV_8UC1);
+	for (int r = 0; r < image.rows; ++r) std::copy(rows[r].begin(), rows[r].end(), image.ptr<uint8_t>(r));
+	return image;
+}
+
+/** `<dir>/<name>.pgm` and `.yaml` (origin 0, `resolution`); returns the yaml. */
+inline std::string writeAsMapServer(
+	const std::string& txt_gz, const std::string& dir, const std::string& name, double resolution = 0.05)
+{
+	const std::string pgm = dir + "/" + name + ".pgm", yaml = dir + "/" + name + ".yaml";
+	if (!cv::imwrite(pgm, readGrid(txt_gz))) throw std::runtime_error("cannot write '" + pgm + "'");
+	std::ofstream(yaml) << "image: " << name << ".pgm\nresolution: " << resolution
+						<< "\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	return yaml;
+}
+
+}  // namespace multires_map_merge::carpin
