@@ -6,6 +6,8 @@
 // cell size is not stated (about 5 cm for the Intel lab): 5 cm. The
 // benchmark's section (carpin_maps.h) and test_real_maps read them so.
 
+#include <multires_map_merge/Similarity2D.h>
+
 #include <mrpt/io/zip.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -43,6 +45,25 @@ inline cv::Mat readGrid(const std::string& txt_gz)
 	cv::Mat image(int(rows.size()), int(rows.front().size()), CV_8UC1);
 	for (int r = 0; r < image.rows; ++r) std::copy(rows[r].begin(), rows[r].end(), image.ptr<uint8_t>(r));
 	return image;
+}
+
+/** ap_hill's four partial maps are written roughly co-registered (best
+ * offsets within 6 cells, turns of a few degrees, which move their far walls
+ * up to ~15 cells): a placement within this of where a map lies (mean over
+ * its occupied cells) is the right place, not a precise one. Another room is
+ * 50 cells and more away. */
+constexpr double kApHillRoughCells = 25;
+
+/** Carpin's copies of the Intel map (800×800 cells), their grid cells (rows
+ * bottom-up) → the Intel map's. intel30 is it shifted by (rows −30, cols
+ * +30): (x − 30, y − 30); intel90 numpy's rot90 of it (pixel (column j, row
+ * i) is the Intel map's (799 − i, j)): (y, 799 − x). */
+inline Similarity2D intelCopyToIntel(const std::string& copy)
+{
+	if (copy == "intel30") return Similarity2D(1, 0, {-30, -30});
+	if (copy == "intel90") return Similarity2D(1, -M_PI / 2, {0, 799});
+	if (copy == "intel") return Similarity2D();
+	throw std::invalid_argument("not one of Carpin's Intel maps: " + copy);
 }
 
 /** `<dir>/<name>.pgm` and `.yaml` (origin 0, `resolution`); returns the yaml. */

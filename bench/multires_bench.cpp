@@ -93,6 +93,13 @@ int rosMapsOnly(const BenchContext& ctx)
 	return wrong ? 1 : 0;
 }
 
+int carpinOnly(const BenchContext& ctx)
+{
+	const CarpinResult result = runCarpinMaps(ctx);
+	writeCarpinSection(std::cout, result);
+	return carpinWrongMerges(result) == 0 ? 0 : 1;
+}
+
 int negativesOnly(const BenchContext& ctx)
 {
 	const auto negatives = runCarmenNegatives(ctx);
@@ -147,7 +154,8 @@ void runMatrices(const BenchContext& ctx, FullRun& run)
 }
 
 /** Halmstad sensor pairs and cross-site negatives, floor plans, OTHER
- * recorded coarser, the independent ROS maps and the Willow pair. */
+ * recorded coarser, the independent ROS maps, Carpin's maps and the Willow
+ * pair. */
 void runRealMaps(const BenchContext& ctx, FullRun& run)
 {
 	const HalmstadData data(ctx.data + "/halmstad");
@@ -166,6 +174,7 @@ void runRealMaps(const BenchContext& ctx, FullRun& run)
 		run.coarser = runCoarserOther(data, data.sites(), kCoarserFactors, ctx.options, dir);
 		fs::remove_all(dir);
 		run.ros_maps = runRosMaps(ctx);
+		run.carpin = runCarpinMaps(ctx);
 	}
 	const std::string w = ctx.data + "/ros_maps/willow/";
 	run.willow = ctx.aligner().alignScaled(
@@ -250,6 +259,8 @@ int main(int argc, char** argv)
 	TCLAP::SwitchArg ros_maps_arg(
 		"", "ros-maps-only", "only the independent ROS maps (ros_maps, SOURCES.md 2b); with --calibration-data: their candidates",
 		cmd);
+	TCLAP::SwitchArg carpin_arg(
+		"", "carpin-only", "only Carpin's map-merging maps (SOURCES.md 4; never tuned on); exit 1 on a wrong merge", cmd);
 	TCLAP::SwitchArg negatives_only_arg(
 		"", "negatives-only", "only the CARMEN pairs that must not merge (different buildings, disjoint parts)", cmd);
 	TCLAP::ValueArg<std::string> fleet_child("", "fleet-child", "internal: place a fleet in a fresh process", false, "", "DIR", cmd);
@@ -313,6 +324,7 @@ int main(int argc, char** argv)
 		if (sets_arg.isSet()) return runAccuracySets(ctx, sets_arg.getValue());
 		if (negatives_only_arg.isSet()) return negativesOnly(ctx);
 		if (ros_maps_arg.isSet()) return rosMapsOnly(ctx);
+		if (carpin_arg.isSet()) return carpinOnly(ctx);
 		if (live_arg.isSet()) return liveOnly(ctx);
 		if (scaling_arg.isSet())
 		{

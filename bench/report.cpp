@@ -384,6 +384,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 	if (!floor_plans.empty()) writeFloorPlanSection(md, floor_plans);
 	if (!coarser.empty()) writeCoarserSection(md, coarser);
 	if (!run.ros_maps.empty()) writeRosMapsSection(md, run.ros_maps);
+	if (!run.carpin.runs.empty()) writeCarpinSection(md, run.carpin);
 }
 
 void writeScalingSection(std::ostream& md, const FullRun& run)
@@ -575,6 +576,9 @@ void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 		   std::to_string(ros_wrong) + " (of " + std::to_string(run.ros_maps.size()) + " pairs, " +
 			   std::to_string(ros_negatives) + " of different places)",
 		   ros_wrong == 0);
+	target("0 merged wrong over Carpin's maps (never tuned on): same place and other places",
+		   std::to_string(carpinWrongMerges(run.carpin)) + " (of " + std::to_string(run.carpin.runs.size()) + " pairs)",
+		   carpinWrongMerges(run.carpin) == 0);
 }
 
 void writeTargets(std::ostream& md, const BenchContext& ctx, const FullRun& run, const Facts& f)

@@ -3,6 +3,7 @@
 // from them: every number in the report comes from the run that wrote it.
 
 #include "carmen.h"
+#include "carpin_maps.h"
 #include "coarser_other.h"
 #include "fleets.h"
 #include "floor_plans.h"
@@ -28,6 +29,7 @@ struct FullRun
 	std::vector<FloorPlanRun> floor_plans;
 	std::vector<CoarserRun> coarser;
 	std::vector<RosMapsRun> ros_maps;
+	CarpinResult carpin;
 	CScalingGridMapAligner::TReturnInfo willow;
 	std::vector<ScalingCase> scaling;
 	std::vector<WholeProcessRow> processes;
