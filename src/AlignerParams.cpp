@@ -65,7 +65,7 @@ const std::vector<AlignerParamField>& alignerParamFields()
 		{"finish_bent_lambda", &P::finish_bent_lambda, 0, 100, no0,
 		 "Maps that bend: the decided transform is refit with this lambda, balancing the bends (0: off)"},
 		// Evidence (MapAgreement.h)
-		{"verify_tolerance", &P::verify_tolerance, 0.5, 50, no0, "Walls this close agree [cells of the coarser map]"},
+		{"verify_tolerance", &P::verify_tolerance, 0.5, 50, no0, "Walls this close agree [cells of the finer map, plus one coarse cell less one fine]"},
 		{"verify_shift", &P::verify_shift, 1, 1000, no0,
 		 "Chance: the transform shifted by this much along each axis [coarse cells]"},
 		{"verify_turn_deg", &P::verify_turn_deg, 1, 90, no0, "Chance: the transform turned by this much [deg]"},

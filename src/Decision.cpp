@@ -72,7 +72,10 @@ double DecisionParams::score(const Evidence& e) const
 
 double DecisionParams::exactConfidence(const Evidence& e) const
 {
-	return e.tolerant_consistency - e.chance_consistency >= exact_min_lead ? e.exact_confidence : 0.0;
+	// Cells that coincide have no bend to take out: B is T there. A lucky
+	// overlap of a squeezed map loses it when its tiles are moved (B < T).
+	const double held = std::min(e.tolerant_consistency, e.bent_consistency);
+	return held - e.chance_consistency >= exact_min_lead ? e.exact_confidence : 0.0;
 }
 
 bool DecisionParams::areRivals(const Placement& a, const Placement& b) const

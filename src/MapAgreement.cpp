@@ -128,6 +128,13 @@ Agreement mapAgreement(
 	return a;
 }
 
+double toleranceInTarget(double tolerance, double source_to_target_scale)
+{
+	const double ratio = std::max(source_to_target_scale, 1.0 / source_to_target_scale);
+	const double in_finer_cells = tolerance + (ratio - 1.0);
+	return source_to_target_scale >= 1.0 ? in_finer_cells : in_finer_cells * source_to_target_scale;
+}
+
 OccupancyField occupancyField(const cv::Mat& classes, MapKind kind)
 {
 	OccupancyField f;
@@ -233,19 +240,17 @@ PointList thinned(const PointList& pts, size_t most)
 
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance, size_t most,
 	bool judge_directions)
 {
 	TwoWaySupport s;
 	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return s;
-	// One coarse cell, in each map's own cells.
-	const double coarse_in_ref = std::max(1.0, other_to_ref.scale);
-	const double coarse_in_other = std::max(1.0, 1.0 / other_to_ref.scale);
 	s.other_in_ref = tolerantSupport(
-		thinned(other_points, most), other_field, other_to_ref, ref_field, tol_coarse * coarse_in_ref, judge_directions);
+		thinned(other_points, most), other_field, other_to_ref, ref_field,
+		toleranceInTarget(tolerance, other_to_ref.scale), judge_directions);
 	s.ref_in_other = tolerantSupport(
-		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field, tol_coarse * coarse_in_other,
-		judge_directions);
+		thinned(ref_points, most), ref_field, other_to_ref.inverse(), other_field,
+		toleranceInTarget(tolerance, 1.0 / other_to_ref.scale), judge_directions);
 	return s;
 }
 
@@ -357,18 +362,18 @@ ShiftField shiftField(
 
 TwoWayShiftField twoWayShiftField(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, size_t most)
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance, size_t most)
 {
 	TwoWayShiftField f;
 	if (!other_to_ref.isFinite() || !(other_to_ref.scale > 0)) return f;
-	// Tolerance, tile, reach and step in coarse cells, in each map's own cells.
+	// Tile, reach and step in coarse cells, in each map's own cells.
 	for (const auto& [points, source, field, t, out] :
 		 {std::tuple{&other_points, &other_field, &ref_field, other_to_ref, &f.other_in_ref},
 		  std::tuple{&ref_points, &ref_field, &other_field, other_to_ref.inverse(), &f.ref_in_other}})
 	{
 		const double coarse = std::max(1.0, t.scale);  // target cells per coarse cell
 		*out = shiftField(
-			thinned(*points, most), *source, t, *field, tol_coarse * coarse, kShiftTileCoarseCells * coarse,
+			thinned(*points, most), *source, t, *field, toleranceInTarget(tolerance, t.scale), kShiftTileCoarseCells * coarse,
 			kShiftReachCoarseCells * coarse, coarse);
 	}
 	return f;
@@ -389,7 +394,7 @@ Similarity2D bendBalanced(const TwoWayShiftField& f, const Similarity2D& other_t
 
 Chance chanceSupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tol_coarse, double shift_coarse,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance, double shift_coarse,
 	double turn_deg, size_t most)
 {
 	if (other_points.empty() || !other_to_ref.isFinite()) return {};
@@ -411,7 +416,7 @@ Chance chanceSupport(
 	for (const auto& m : moves)
 	{
 		const TwoWaySupport s =
-			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tol_coarse, most, false);
+			twoWaySupport(ref_points, ref_field, other_points, other_field, m.compose(other_to_ref), tolerance, most, false);
 		best.support = std::max(best.support, s.score());
 		best.consistency = std::max(best.consistency, s.consistency());
 	}

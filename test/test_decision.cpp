@@ -129,8 +129,13 @@ TEST(Decision, CellsCoincidingMergeOnlyWhereTheyStandAboveChance)
 	peak.exact_confidence = 0.9;
 	Evidence flat = peak;
 	flat.chance_consistency = 0.99 - 0.9 * DecisionParams::exact_min_lead;
+	// The lead must hold with the bends taken out: tiles of a lucky overlap,
+	// moved as their neighbours fit best, agree less than unmoved.
+	Evidence unbent = peak;
+	unbent.bent_consistency = peak.chance_consistency + 0.9 * DecisionParams::exact_min_lead;
 	EXPECT_EQ(p.exactConfidence(peak), 0.9);
 	EXPECT_EQ(p.exactConfidence(flat), 0);
+	EXPECT_EQ(p.exactConfidence(unbent), 0);
 	const Decision on_peak = decide({at(peak, 0)}, p), on_flat = decide({at(flat, 0)}, p);
 	EXPECT_LT(on_peak.value, p.threshold) << "the walls' evidence is too little";
 	EXPECT_TRUE(on_peak.merged);

@@ -185,10 +185,10 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 TEST(RealMaps, HalmstadPairMergesWhicheverMapIsNamedFirst)
 {
 	REQUIRE_HALMSTAD();
-	// E5_04 <- E5_11 merges; E5_11 <- E5_04 is refused as searched (the
+	// E5_14 <- E5_12 merges; E5_12 <- E5_14 is refused as searched (the
 	// search is not symmetric in the maps), and with both_orders merges
 	// with the roles swapped back: the same alignment, inverted.
-	const GridInFrame a = loadGridMap(halmstad()->yaml("E5_11", dir())), b = loadGridMap(halmstad()->yaml("E5_04", dir()));
+	const GridInFrame a = loadGridMap(halmstad()->yaml("E5_12", dir())), b = loadGridMap(halmstad()->yaml("E5_14", dir()));
 	CScalingGridMapAligner aligner;
 	EXPECT_FALSE(aligner.options.both_orders) << "the default";
 	const auto one_way = aligner.alignScaled(a, b);
@@ -203,7 +203,7 @@ TEST(RealMaps, HalmstadPairMergesWhicheverMapIsNamedFirst)
 	EXPECT_NEAR(round_trip.t.norm(), 0, 1e-6);
 	EXPECT_NEAR(round_trip.scale, 1, 1e-9);
 	EXPECT_NEAR(named_first.implied_resolution_other * other_way.implied_resolution_other, 0.05 * 0.05, 1e-9);
-	const auto truth = halmstad()->pair("E5_04", "E5_11");
+	const auto truth = halmstad()->pair("E5_14", "E5_12");
 	ASSERT_NE(truth, nullptr);
 	EXPECT_TRUE(multires_bench::judge(named_first.metric, *truth, b, static_cast<int>(a.grid.getSizeY())).right);
 }

@@ -278,14 +278,15 @@ TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)
 	turn.t = centre - turn.apply(centre);
 	const TwoWaySupport turned = m.at(turn);
 	EXPECT_LT(turned.wallAlignment(), 0.5);
-	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 100u) << "turned walls still lie near walls";
+	EXPECT_GT(turned.other_in_ref.directed + turned.ref_in_other.directed, 50u) << "turned walls still lie near walls";
 }
 
 namespace
 {
 /** The malaga pair with the other map bent smoothly, as SLAM bends walls:
  * each cell moved by a sine wave of up to `amplitude` cells across the map;
- * judged (tolerance 3 cells) under the truth or wrong transforms. */
+ * judged (verify_tolerance 3: 4 cells of the finer map, 2 of its own) under
+ * the truth or wrong transforms. */
 struct BentMalaga : MalagaSupport
 {
 	PointList bent_edges;
@@ -335,14 +336,15 @@ TEST(MapAgreement, RegionsShiftAlikeUnderTheTruthNotWhenTurned)
 	const TwoWayShiftField at_truth = m.shifts(m.truth);
 	EXPECT_GT(at_truth.coherence(), 0.6);
 	EXPECT_GT(at_truth.other_in_ref.neighbour_pairs + at_truth.ref_in_other.neighbour_pairs, 20u);
-	EXPECT_GT(m.rigidConsistency(m.truth), 0.7) << "bent, yet the walls still lie near each other";
+	EXPECT_GT(m.rigidConsistency(m.truth), m.rigidConsistency(m.turned()) + 0.2)
+		<< "bent, yet the walls lie nearer each other than turned";
 	EXPECT_LT(m.shifts(m.turned()).coherence(), 0.3);
 	EXPECT_LT(m.shifts(m.slid()).coherence(), at_truth.coherence() - 0.3);
 }
 
 TEST(MapAgreement, TakingOutASmoothBendRestoresTheWallsUnderTheTruthOnly)
 {
-	// Bent by up to 7 cells, beyond the tolerance (3): under the truth many
+	// Bent by up to 7 cells, beyond the tolerance (2): under the truth many
 	// walls miss the other map's, yet each region's neighbours predict the
 	// shift that puts it back (the bent consistency). A wrong transform's
 	// regions fit by shifts of their own, which predict nothing.

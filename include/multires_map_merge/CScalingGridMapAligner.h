@@ -136,8 +136,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * orders (docs/method.md, step 6). 0: off. */
 		double finish_bent_lambda = 4.0;
 		// --- Evidence (MapAgreement.h)
-		/** Walls within this many cells of the coarser map agree: independent
-		 * SLAM maps bend and thicken walls by a few cells. */
+		/** Walls within this many cells of the finer map, plus the coarser
+		 * map's quantisation, agree: independent SLAM maps bend and thicken
+		 * walls by a few cells (toleranceInTarget, MapAgreement.h). */
 		double verify_tolerance = 3.0;
 		/** The far perturbations that measure chance: shifts of this many
 		 * coarse cells along each axis, turns of ± verify_turn_deg. */

@@ -110,7 +110,18 @@ inline double pooledConsistency(const Support& a, const Support& b)
 	return a.judged + b.judged ? 1.0 - pooledShare(a.conflicts, b.conflicts, a.judged, b.judged) : 0.0;
 }
 
-/** Both ways, for a transform between two maps' cells. */
+/** The verification tolerance in a target map's cells, for points moved in
+ * by a similarity of this scale: `tolerance` cells of the finer map (how far
+ * independent maps bend and thicken walls: a distance in the world, which
+ * the finer map measures best) plus the coarser map's quantisation (a wall
+ * lies anywhere within the coarse cells that drew it: one coarse cell less
+ * one fine). Equal cells: `tolerance`. Not `tolerance` coarse cells: a map
+ * recorded 2x coarser would then be judged at twice the distance, where
+ * walls of look-alike rooms turned onto each other agree (Halmstad E5). */
+double toleranceInTarget(double tolerance, double source_to_target_scale);
+
+/** Both ways, for a transform between two maps' cells; `tolerance` as
+ * toleranceInTarget. */
 struct TwoWaySupport
 {
 	Support other_in_ref, ref_in_other;
@@ -133,7 +144,7 @@ struct TwoWaySupport
 
 TwoWaySupport twoWaySupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance,
 	size_t most_points = kJudgedPoints, bool judge_directions = true);
 
 /** Whether the walls agree region by region the same way. SLAM bends a map
@@ -192,7 +203,7 @@ struct TwoWayShiftField
 };
 TwoWayShiftField twoWayShiftField(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance,
 	size_t most_points = kJudgedPoints);
 
 /** The similarity that best takes every fitted tile of `f` (both
@@ -212,7 +223,7 @@ struct Chance
 };
 Chance chanceSupport(
 	const PointList& ref_points, const OccupancyField& ref_field, const PointList& other_points,
-	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance_coarse_cells,
+	const OccupancyField& other_field, const Similarity2D& other_to_ref, double tolerance,
 	double shift_coarse_cells, double turn_deg, size_t most_points = kJudgedPoints);
 
 }  // namespace multires_map_merge

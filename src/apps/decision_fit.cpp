@@ -19,8 +19,9 @@
 // right against the truth); each file is a sample of its own (the same pair
 // aligned by another build has other hypotheses, hence other rivals): the
 // fit must hold on every one, merges are counted over all. Only rows marked
-// calibration = 1 are read (E5 and HIH pairs, their floor plans, the
-// negatives, the live fleet's growing maps, the ROS maps: bench/calibration.h);
+// calibration = 1 are read (E5 and HIH pairs, their floor plans, OTHER
+// recorded coarser, the negatives, the live fleet's growing maps, the ROS
+// maps: bench/calibration.h);
 // F5 and KPT4A pairs never are.
 //
 // The fit: for each point of the grid below, the threshold is set the
@@ -104,13 +105,6 @@ struct FitPair
 	std::vector<bool> wrong;  //!< per candidate: wrong when decided on (neither right nor near)
 };
 
-/** Pairs the calibration data holds but the fit leaves out: OTHER recorded
- * coarser (`other` E5_05_x2). Their highest wrong best candidate (E5_11 <-
- * E5_05 x2, 0.702) has the evidence of the weakest right merges; fitting it
- * moves the grid to a threshold that refuses a seventh of E5's sensor pairs
- * and most of its floor plans. The benchmark reports them. */
-bool notFitted(const CandidatePair& p) { return p.other.find("_x") != std::string::npos; }
-
 unsigned groupsOf(const CandidatePair& p)
 {
 	auto bit = [](const std::string& group) {
@@ -138,7 +132,7 @@ std::vector<FitPair> loadCalibrationPairs(const std::vector<std::string>& paths,
 	{
 		for (CandidatePair& p : loadCandidatePairs(paths[s]))
 		{
-			if (!p.calibration || notFitted(p)) continue;
+			if (!p.calibration) continue;
 			FitPair f;
 			f.sample = s;
 			f.kind = !p.positive ? Kind::negative : p.site == "live" ? Kind::live : Kind::positive;
