@@ -236,22 +236,6 @@ Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, 
 	return betweenMapFrames(ref, cellToMetric(ref.grid).compose(cells).compose(cellToMetric(other.grid).inverse()), other);
 }
 
-double meanDisplacementPx(const Similarity2D& est, const Similarity2D& truth_px, const GridInFrame& other, int ref_rows)
-{
-	if (!est.isFinite()) return NAN;
-	const int src_rows = static_cast<int>(other.grid.getSizeY());
-	std::vector<cv::Point> occupied;
-	cv::findNonZero(toClassImage(other.grid) == kOccupied, occupied);
-	double sum = 0;
-	for (const auto& c : occupied)
-	{
-		// Class images have row = cy (y up): pixel v = rows − 1 − cy.
-		const Eigen::Vector2d px(c.x, src_rows - 1 - c.y);
-		sum += (metricToPx(est(pxToMetric(px, src_rows)), ref_rows) - truth_px(px)).norm();
-	}
-	return occupied.empty() ? NAN : sum / occupied.size();
-}
-
 namespace
 {
 /** The pixels of a map's occupied cells (u, v from the top). */
@@ -265,6 +249,16 @@ std::vector<Eigen::Vector2d> occupiedPx(const GridInFrame& map)
 	return out;
 }
 }  // namespace
+
+double meanDisplacementPx(const Similarity2D& est, const Similarity2D& truth_px, const GridInFrame& other, int ref_rows)
+{
+	if (!est.isFinite()) return NAN;
+	const int src_rows = static_cast<int>(other.grid.getSizeY());
+	const std::vector<Eigen::Vector2d> occupied = occupiedPx(other);
+	double sum = 0;
+	for (const auto& px : occupied) sum += (metricToPx(est(pxToMetric(px, src_rows)), ref_rows) - truth_px(px)).norm();
+	return occupied.empty() ? NAN : sum / occupied.size();
+}
 
 double annotationDisagreementPx(
 	const HalmstadData& data, const std::vector<std::string>& maps, const std::vector<GridInFrame>& loaded)

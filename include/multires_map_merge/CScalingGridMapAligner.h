@@ -122,8 +122,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double finish_max_shift = 1.5;  //!< cells of the coarser map
 		/** The finish's last step (LatticeShift.h): the sub-cell shift that
 		 * makes the finer map's occupied cells, drawn on the coarser map's
-		 * lattice, cover the coarser map's, searched in steps of this many
-		 * coarse cells over ± half a cell (0: off). */
+		 * lattice, cover the coarser map's: the best whole-cell slip within
+		 * one cell, then steps of this many coarse cells over ± half a cell
+		 * around it (0: off). */
 		double finish_lattice_step = 0.05;
 		/** Where the decided edges are 1.5 coarse cells apart or more (maps
 		 * that bend: no finish on occupied cells), the decided transform is
@@ -210,7 +211,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * `screened` (no rival, never chosen). */
 		bool converged_on_exact = false;
 		/** Found for the mirrored other map (mirror_check): a rival of
-		 * every candidate, never chosen. */
+		 * every candidate, never chosen. Its `cells` take the mirrored map's
+		 * cells (with TReturnInfo::roles_swapped: the other map's cells to
+		 * the mirrored reference's). */
 		bool mirrored = false;
 	};
 

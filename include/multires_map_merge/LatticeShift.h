@@ -1,10 +1,12 @@
 #pragma once
-// The last sub-cell step of the finish. A coarse map marks a cell occupied
-// when a wall passes anywhere through it, so its walls sit on its lattice,
-// up to half a cell from where they are; any fit of distances to coarse cell
-// centres keeps part of that rounding. Drawing the finer map's occupied cells
-// on the coarse lattice the same way and shifting them until they fill the
-// coarse map's occupied cells, no more and no fewer, undoes it.
+// The last step of the finish: a whole-cell slip, then a sub-cell shift. A
+// coarse map marks a cell occupied when a wall passes anywhere through it,
+// so its walls sit on its lattice, up to half a cell from where they are;
+// any fit of distances to coarse cell centres keeps part of that rounding.
+// Drawing the finer map's occupied cells on the coarse lattice the same way
+// and shifting them until they fill the coarse map's occupied cells, no more
+// and no fewer, undoes it. Walls two cells thick let a fit slip a whole cell
+// (one face on the other): the whole-cell shifts are compared first.
 
 #include <multires_map_merge/TsICP.h>
 
@@ -15,7 +17,9 @@ namespace multires_map_merge
 {
 struct LatticeShiftParams
 {
-	double range = 0.5;  //!< largest shift tried along each axis, coarse cells
+	/** Largest sub-cell shift tried along each axis around the best
+	 * whole-cell slip (within one cell), coarse cells: 1 + range in all. */
+	double range = 0.5;
 	double step = 0.05;  //!< finest shift step, coarse cells
 	/** Shifts whose mismatch is within this share of the least are all as
 	 * good (a shift moves no point across a cell border for a while): the
