@@ -171,9 +171,9 @@ void writeHalmstadFleetSection(
 		  "occupied pixels, px of 5 cm). *Mixed cells*: the maps recorded ×1, ×2, ×1.4 in turn, all stated "
 		  "0.05 m. *Tree alone*: the same pairs, each map placed through its one most confident path (joint "
 		  "refinement off). *Dropped by a cycle*: confident pairs that disagree with the tree at the corners of what "
-		  "the map saw by more than the tolerance of the cycle's least precise pair (`cycle_tolerance_per_rmse` ("
-	   << fleet.cycle_tolerance_per_rmse << ") × its edge RMSE, within " << fleet.cycle_tolerance_cells
-	   << "–" << fleet.maxToleranceCells() << " cells); "
+		  "the map saw by more than the cycle's tolerance (each pair's `cycle_tolerance_per_rmse` ("
+	   << fleet.cycle_tolerance_per_rmse << ") × its edge RMSE, added in quadrature around the cycle, within "
+	   << fleet.cycle_tolerance_cells << "–" << fleet.maxToleranceCells() << " cells); "
 		  "the joint refinement uses only the pairs kept. *Against every annotated pair*: the same displacement "
 		  "against the maps placed from all the site's annotated correspondences at once (least squares, the "
 		  "reference fixed), an annotation consistent around every cycle. *Annotations' own disagreement*: how far one "

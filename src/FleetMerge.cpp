@@ -23,11 +23,29 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
+namespace
+{
+/** What a pair's precision allows (cycle_tolerance_per_rmse × its edge RMSE), unclamped. */
+double byPrecision(const FleetParams& p, const FleetEdge& e)
+{
+	const double cells = p.cycle_tolerance_per_rmse * e.rmse_coarse_cells;
+	return std::isfinite(cells) ? cells : 0.0;
+}
+}  // namespace
+
 double FleetParams::toleranceOf(const FleetEdge& e) const
 {
-	const double by_precision = cycle_tolerance_per_rmse * e.rmse_coarse_cells;
-	return std::clamp(std::isfinite(by_precision) ? by_precision : 0.0, cycle_tolerance_cells,
-		std::max(cycle_tolerance_cells, maxToleranceCells()));
+	return std::clamp(byPrecision(*this, e), cycle_tolerance_cells, std::max(cycle_tolerance_cells, maxToleranceCells()));
+}
+
+double FleetParams::cycleTolerance(const std::vector<int>& cycle, const std::vector<FleetEdge>& edges) const
+{
+	// Each pair's error adds to the cycle's closure independently: they add
+	// in quadrature (a direct pair and a chain of three bent pairs disagree
+	// by about the chain's errors combined, not by one pair's).
+	double sum_sq = 0;
+	for (int c : cycle) sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]), 2);
+	return std::clamp(std::sqrt(sum_sq), cycle_tolerance_cells, std::max(cycle_tolerance_cells, maxToleranceCells()));
 }
 
 FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
@@ -283,8 +301,7 @@ std::vector<int> cycleOf(const Tree& t, const std::vector<FleetEdge>& edges, int
 }
 
 /** Builds the tree; while a kept non-tree edge contradicts it (by more than
- * the tolerance of the cycle's least precise pair), drops the weakest edge of
- * that cycle and rebuilds. */
+ * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds. */
 Tree consistentTree(
 	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
 	std::vector<FleetEdge>& edges, const FleetParams& params)
@@ -299,8 +316,7 @@ Tree consistentTree(
 			if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
 			if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
 			const std::vector<int> cycle = cycleOf(t, edges, int(k));
-			double tol = 0;
-			for (int c : cycle) tol = std::max(tol, params.toleranceOf(edges[c]));
+			const double tol = params.cycleTolerance(cycle, edges);
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
 			if (disagreementCells(maps[e.from], corners[e.from], maps[e.to], predicted, e.from_to_to) > tol)
 				contradicted = cycle;
@@ -311,6 +327,25 @@ Tree consistentTree(
 		});
 		edges[weakest].dropped = true;
 	}
+}
+
+/** Per map, the largest tolerance of a cycle it lies on (0: on none): how far
+ * the cycle check let the pairs around it disagree, so how far the joint
+ * refinement may move it from its tree placement. */
+std::vector<double> cycleMoves(const Tree& t, const std::vector<FleetEdge>& edges, const FleetParams& params)
+{
+	std::vector<double> out(t.maps.size(), 0.0);
+	for (size_t k = 0; k < edges.size(); ++k)
+	{
+		const FleetEdge& e = edges[k];
+		if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
+		if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
+		const std::vector<int> cycle = cycleOf(t, edges, int(k));
+		const double tol = params.cycleTolerance(cycle, edges);
+		for (int c : cycle)
+			for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to}) out[m] = std::max(out[m], tol);
+	}
+	return out;
 }
 
 using PairKey = std::pair<size_t, size_t>;  // (lower, higher) map index
@@ -442,7 +477,8 @@ FleetResult placeFromPairs(
 	{
 		std::vector<double> tolerance;
 		for (const auto& e : out.edges) tolerance.push_back(params.toleranceOf(e));
-		const auto joint = refineJointly(maps, reference, out.maps, out.edges, corners, tolerance);
+		const auto joint =
+			refineJointly(maps, reference, out.maps, out.edges, corners, tolerance, cycleMoves(tree, out.edges, params));
 		for (size_t m = 0; m < maps.size(); ++m)
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";

@@ -33,7 +33,8 @@ double coarseCellInReference(
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
 	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
-	const std::vector<double>& tolerance_cells, const JointPlacementParams& params)
+	const std::vector<double>& tolerance_cells, const std::vector<double>& max_move_cells,
+	const JointPlacementParams& params)
 {
 	const size_t n = maps.size();
 	std::vector<std::optional<Similarity2D>> out(n);
@@ -43,13 +44,14 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 	for (size_t m = 0; m < n; ++m)
 		if (m != reference && placements[m].placed) column[m] = 4 * unknowns++;
 	std::vector<size_t> used;
-	std::vector<double> max_move_cells(n, 0.0);  // per map: the largest tolerance of its pairs used
+	std::vector<double> max_move(max_move_cells);  // per map
+	max_move.resize(n, 0.0);
 	for (size_t k = 0; k < edges.size(); ++k)
 	{
 		const FleetEdge& e = edges[k];
 		if (!e.merged || e.dropped || !placements[e.from].placed || !placements[e.to].placed) continue;
 		used.push_back(k);
-		for (size_t m : {e.from, e.to}) max_move_cells[m] = std::max(max_move_cells[m], tolerance_cells[k]);
+		for (size_t m : {e.from, e.to}) max_move[m] = std::max(max_move[m], tolerance_cells[k]);
 	}
 	if (unknowns == 0 || used.size() <= size_t(unknowns)) return out;  // a tree: nothing to balance
 
@@ -107,7 +109,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		const Similarity2D& tree = placements[m].in_reference;
 		const double cell = std::max<double>(
 			maps[reference].grid.getResolution(), maps[m].grid.getResolution() * tree.scale);
-		if (cornersRms(corners[m], joint, tree) / cell <= max_move_cells[m]) out[m] = joint;
+		if (cornersRms(corners[m], joint, tree) / cell <= max_move[m]) out[m] = joint;
 	}
 	return out;
 }

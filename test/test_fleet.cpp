@@ -491,3 +491,50 @@ TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)
 	EXPECT_NEAR(off_path + off_direct, 8.0, 0.5);
 	EXPECT_NE(bent.maps[2].message.find("refined jointly"), std::string::npos) << bent.maps[2].message;
 }
+
+TEST(FleetGraph, AChainsErrorsAddUpAroundACycle)
+{
+	// Map 3 is placed through the chain 0 <- 1 <- 2 <- 3 (the surer path); the
+	// direct pair 0 <- 3 is 12 cells (1.2 m) off it. Bent maps fitting at an
+	// edge RMSE of 2 cells (a pair's tolerance 8) disagree that much around a
+	// cycle of four pairs when all are right (their errors add in quadrature:
+	// 16): kept. Precise maps (RMSE 0.3: the 3-cell floor) 4 cells apart around
+	// the same cycle mean one pair is off: dropped.
+	const std::vector<Similarity2D> truth = {
+		{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1.25, -0.5, {-3, 4}), Similarity2D(0.8, 2.0, {5, -2})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	auto placed = [&](double rmse_cells, double direct_off_m) {
+		Similarity2D direct = between(3, 0);
+		direct.t += Eigen::Vector2d(direct_off_m, 0);
+		std::vector<FleetEdge> edges = {edge(1, 0, between(1, 0), 0.99), edge(2, 1, between(2, 1), 0.99),
+										edge(3, 2, between(3, 2), 0.99), edge(3, 0, direct, 0.7)};
+		for (auto& e : edges) e.rmse_coarse_cells = rmse_cells;
+		return std::make_pair(placeFromPairs(blankMaps(4), 0, edges), edges);
+	};
+	const auto [bent, bent_edges] = placed(2.0, 1.2);
+	const FleetParams defaults;
+	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, bent_edges), 16.0);
+	EXPECT_DOUBLE_EQ(defaults.toleranceOf(bent_edges[3]), 8.0);  // one pair's: 12 cells would contradict it
+	EXPECT_FALSE(bent.edges[3].dropped);
+	// The joint refinement may move map 3 as far as its cycle let the pairs
+	// disagree: it lands between the chain and the direct pair.
+	const std::vector<GridInFrame> maps = blankMaps(4);
+	Similarity2D direct = between(3, 0);
+	direct.t += Eigen::Vector2d(1.2, 0);
+	const double off_chain = cornerRms(maps[3], bent.maps[3].in_reference, truth[3]) / 0.1,
+				 off_direct = cornerRms(maps[3], bent.maps[3].in_reference, direct) / 0.1;
+	EXPECT_GT(off_chain, 2.0);
+	EXPECT_GT(off_direct, 1.0);
+	EXPECT_NEAR(off_chain + off_direct, 12.0, 0.5);
+	EXPECT_NE(bent.maps[3].message.find("refined jointly"), std::string::npos) << bent.maps[3].message;
+
+	const auto [precise, precise_edges] = placed(0.3, 0.4);
+	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, precise_edges), defaults.cycle_tolerance_cells);
+	EXPECT_TRUE(precise.edges[3].dropped);
+	expectNear(precise.maps[3].in_reference, truth[3]);
+
+	// At most what the decision tells apart as rival placements.
+	std::vector<FleetEdge> loose = bent_edges;
+	for (auto& e : loose) e.rmse_coarse_cells = 30;
+	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, loose), defaults.maxToleranceCells());
+}

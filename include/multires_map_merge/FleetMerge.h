@@ -87,7 +87,9 @@ struct FleetParams
 	 * contradictory. A pair's tolerance follows its precision:
 	 * `cycle_tolerance_per_rmse` × its edge RMSE, at least
 	 * `cycle_tolerance_cells` and at most `cycle_tolerance_max_cells`; a
-	 * cycle's is that of its least precise pair. Tight for precise pairs on
+	 * cycle's adds its pairs' `cycle_tolerance_per_rmse` × edge RMSE in
+	 * quadrature (their errors add up around it), within the same bounds.
+	 * Tight for precise pairs on
 	 * purpose: two pairs of precise maps 4 cells apart means one is off, and
 	 * the joint refinement would land between them. Right pairs of bent real
 	 * maps disagree by 2–35 cells and fit at an RMSE of 1–10 cells. */
@@ -99,6 +101,8 @@ struct FleetParams
 	double cycle_tolerance_max_cells = 0;
 	/** The tolerance of one pair (see cycle_tolerance_cells). */
 	double toleranceOf(const FleetEdge& e) const;
+	/** The tolerance of a cycle of `edges` (indices; see cycle_tolerance_cells). */
+	double cycleTolerance(const std::vector<int>& cycle, const std::vector<FleetEdge>& edges) const;
 	/** The largest tolerance: cycle_tolerance_max_cells, or its default. */
 	double maxToleranceCells() const;
 	/** These parameters with cycle_tolerance_max_cells 0 set to the

@@ -29,14 +29,16 @@ struct JointPlacementParams
  * `from` map's content (`corners`, one per map) in units of its tolerance
  * (`tolerance_cells`, one per edge, cells of its coarser map: FleetParams::
  * toleranceOf), so a precise pair counts more than one of bent maps. A map
- * whose refined pose moves its content by more than the largest tolerance of
- * its pairs from its tree placement keeps the tree's (the cycle check admits
- * pairs within that much of each other: a larger move means the pairs do not
- * support one placement). Returns, per map, the refined pose, or nothing
- * where the tree's stays. */
+ * whose refined pose moves its content from its tree placement by more than
+ * its `max_move_cells` (one per map; the cycle check admits pairs that far
+ * apart around the cycles it lies on), or than the largest tolerance of its
+ * pairs, keeps the tree's: a larger move means the pairs do not support one
+ * placement. Returns, per map, the refined pose, or nothing where the tree's
+ * stays. */
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
 	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
-	const std::vector<double>& tolerance_cells, const JointPlacementParams& params = {});
+	const std::vector<double>& tolerance_cells, const std::vector<double>& max_move_cells,
+	const JointPlacementParams& params = {});
 
 }  // namespace multires_map_merge
