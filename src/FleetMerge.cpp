@@ -300,6 +300,14 @@ std::vector<int> cycleOf(const Tree& t, const std::vector<FleetEdge>& edges, int
 	return cycle;
 }
 
+/** Edge k is kept, joins two placed maps and is not on the tree: it closes a cycle. */
+bool closesACycle(const Tree& t, const std::vector<FleetEdge>& edges, size_t k)
+{
+	const FleetEdge& e = edges[k];
+	return e.merged && !e.dropped && t.maps[e.from].placed && t.maps[e.to].placed && t.via_edge[e.from] != int(k) &&
+		t.via_edge[e.to] != int(k);
+}
+
 /** Builds the tree; while a kept non-tree edge contradicts it (by more than
  * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds. */
 Tree consistentTree(
@@ -312,9 +320,8 @@ Tree consistentTree(
 		std::vector<int> contradicted;
 		for (size_t k = 0; k < edges.size() && contradicted.empty(); ++k)
 		{
+			if (!closesACycle(t, edges, k)) continue;
 			const FleetEdge& e = edges[k];
-			if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
-			if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
 			const std::vector<int> cycle = cycleOf(t, edges, int(k));
 			const double tol = params.cycleTolerance(cycle, edges);
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
@@ -337,9 +344,7 @@ std::vector<double> cycleMoves(const Tree& t, const std::vector<FleetEdge>& edge
 	std::vector<double> out(t.maps.size(), 0.0);
 	for (size_t k = 0; k < edges.size(); ++k)
 	{
-		const FleetEdge& e = edges[k];
-		if (!e.merged || e.dropped || !t.maps[e.from].placed || !t.maps[e.to].placed) continue;
-		if (t.via_edge[e.from] == int(k) || t.via_edge[e.to] == int(k)) continue;
+		if (!closesACycle(t, edges, k)) continue;
 		const std::vector<int> cycle = cycleOf(t, edges, int(k));
 		const double tol = params.cycleTolerance(cycle, edges);
 		for (int c : cycle)
