@@ -31,12 +31,15 @@ double byPrecision(const FleetParams& p, const FleetEdge& e)
 	const double cells = p.cycle_tolerance_per_rmse * e.rmse_coarse_cells;
 	return std::isfinite(cells) ? cells : 0.0;
 }
+
+/** `cells` within cycle_tolerance_cells and the largest tolerance. */
+double withinToleranceBounds(const FleetParams& p, double cells)
+{
+	return std::clamp(cells, p.cycle_tolerance_cells, std::max(p.cycle_tolerance_cells, p.maxToleranceCells()));
+}
 }  // namespace
 
-double FleetParams::toleranceOf(const FleetEdge& e) const
-{
-	return std::clamp(byPrecision(*this, e), cycle_tolerance_cells, std::max(cycle_tolerance_cells, maxToleranceCells()));
-}
+double FleetParams::toleranceOf(const FleetEdge& e) const { return withinToleranceBounds(*this, byPrecision(*this, e)); }
 
 double FleetParams::cycleTolerance(const std::vector<int>& cycle, const std::vector<FleetEdge>& edges) const
 {
@@ -45,7 +48,7 @@ double FleetParams::cycleTolerance(const std::vector<int>& cycle, const std::vec
 	// by about the chain's errors combined, not by one pair's).
 	double sum_sq = 0;
 	for (int c : cycle) sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]), 2);
-	return std::clamp(std::sqrt(sum_sq), cycle_tolerance_cells, std::max(cycle_tolerance_cells, maxToleranceCells()));
+	return withinToleranceBounds(*this, std::sqrt(sum_sq));
 }
 
 FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
@@ -226,6 +229,10 @@ struct Tree
 {
 	std::vector<FleetPlacement> maps;
 	std::vector<int> via_edge;  // the tree edge placing each map (-1: none)
+	/** Per map, the largest tolerance of a cycle it lies on (0: none; set
+	 * by consistentTree): how far the cycle check let the pairs around it
+	 * disagree, so how far the joint refinement may move it. */
+	std::vector<double> cycle_tolerance;
 };
 
 /** Maximum spanning tree from the reference over the confident, kept edges
@@ -309,7 +316,8 @@ bool closesACycle(const Tree& t, const std::vector<FleetEdge>& edges, size_t k)
 }
 
 /** Builds the tree; while a kept non-tree edge contradicts it (by more than
- * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds. */
+ * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds.
+ * The tree returned holds every map's largest cycle tolerance. */
 Tree consistentTree(
 	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
 	std::vector<FleetEdge>& edges, const FleetParams& params)
@@ -318,6 +326,7 @@ Tree consistentTree(
 	{
 		Tree t = spanningTree(maps.size(), reference, edges, params.settled_confidence);
 		std::vector<int> contradicted;
+		t.cycle_tolerance.assign(maps.size(), 0.0);
 		for (size_t k = 0; k < edges.size() && contradicted.empty(); ++k)
 		{
 			if (!closesACycle(t, edges, k)) continue;
@@ -327,6 +336,9 @@ Tree consistentTree(
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
 			if (disagreementCells(maps[e.from], corners[e.from], maps[e.to], predicted, e.from_to_to) > tol)
 				contradicted = cycle;
+			for (int c : cycle)
+				for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to})
+					t.cycle_tolerance[m] = std::max(t.cycle_tolerance[m], tol);
 		}
 		if (contradicted.empty()) return t;
 		const int weakest = *std::min_element(contradicted.begin(), contradicted.end(), [&](int a, int b) {
@@ -334,23 +346,6 @@ Tree consistentTree(
 		});
 		edges[weakest].dropped = true;
 	}
-}
-
-/** Per map, the largest tolerance of a cycle it lies on (0: on none): how far
- * the cycle check let the pairs around it disagree, so how far the joint
- * refinement may move it from its tree placement. */
-std::vector<double> cycleMoves(const Tree& t, const std::vector<FleetEdge>& edges, const FleetParams& params)
-{
-	std::vector<double> out(t.maps.size(), 0.0);
-	for (size_t k = 0; k < edges.size(); ++k)
-	{
-		if (!closesACycle(t, edges, k)) continue;
-		const std::vector<int> cycle = cycleOf(t, edges, int(k));
-		const double tol = params.cycleTolerance(cycle, edges);
-		for (int c : cycle)
-			for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to}) out[m] = std::max(out[m], tol);
-	}
-	return out;
 }
 
 using PairKey = std::pair<size_t, size_t>;  // (lower, higher) map index
@@ -483,7 +478,7 @@ FleetResult placeFromPairs(
 		std::vector<double> tolerance;
 		for (const auto& e : out.edges) tolerance.push_back(params.toleranceOf(e));
 		const auto joint =
-			refineJointly(maps, reference, out.maps, out.edges, corners, tolerance, cycleMoves(tree, out.edges, params));
+			refineJointly(maps, reference, out.maps, out.edges, corners, tolerance, tree.cycle_tolerance);
 		for (size_t m = 0; m < maps.size(); ++m)
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
