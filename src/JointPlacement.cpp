@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <stdexcept>
 
 namespace multires_map_merge
 {
@@ -37,6 +38,11 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 	const JointPlacementParams& params)
 {
 	const size_t n = maps.size();
+	// One per map and one per edge: a list of another length is a caller's mix-up, said, not padded.
+	if (placements.size() != n || corners.size() != n || max_move_cells.size() != n)
+		throw std::invalid_argument("refineJointly: placements, corners and max_move_cells need one entry per map");
+	if (tolerance_cells.size() != edges.size())
+		throw std::invalid_argument("refineJointly: tolerance_cells needs one entry per edge");
 	std::vector<std::optional<Similarity2D>> out(n);
 	// The unknowns: (Re a, Im a, Re b, Im b) of each placed map but the reference.
 	std::vector<int> column(n, -1);
@@ -44,8 +50,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 	for (size_t m = 0; m < n; ++m)
 		if (m != reference && placements[m].placed) column[m] = 4 * unknowns++;
 	std::vector<size_t> used;
-	std::vector<double> max_move(max_move_cells);  // per map
-	max_move.resize(n, 0.0);
+	std::vector<double> max_move(max_move_cells);
 	for (size_t k = 0; k < edges.size(); ++k)
 	{
 		const FleetEdge& e = edges[k];

@@ -6,6 +6,7 @@
 #include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/JointPlacement.h>
 #include <multires_map_merge/MapIO.h>
 
 #include <mrpt/config/CConfigFile.h>
@@ -447,6 +448,12 @@ TEST(FleetGraph, JointRefinementPlacesAChainedMapByEveryPairThatSeesIt)
 	// Its parent and confidence are still the tree's: the path that placed it first.
 	EXPECT_EQ(joint.maps[3].parent, 2);
 	EXPECT_DOUBLE_EQ(joint.maps[3].confidence, 0.99);
+	// A list of the wrong length is said, not padded with zeros.
+	const std::vector<ContentCorners> corners(4, contentCorners(maps[0]));
+	const std::vector<double> per_edge(edges.size(), 3.0), per_map(4, 3.0);
+	EXPECT_NO_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_edge, per_map));
+	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_edge, {3.0}), std::invalid_argument);
+	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_map, per_map), std::invalid_argument);
 }
 
 TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)

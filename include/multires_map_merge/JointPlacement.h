@@ -34,7 +34,8 @@ struct JointPlacementParams
  * apart around the cycles it lies on), or than the largest tolerance of its
  * pairs, keeps the tree's: a larger move means the pairs do not support one
  * placement. Returns, per map, the refined pose, or nothing where the tree's
- * stays. */
+ * stays. Throws std::invalid_argument when a per-map or per-edge list is
+ * not one entry per map or edge. */
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
 	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
