@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <set>
+#include <stdexcept>
 
 namespace multires_bench
 {
@@ -133,29 +135,54 @@ std::string yamlOf(const BenchContext& ctx, const RosPlace& place, const std::st
 /** Every map of every place, read once: "place/stem" → map. */
 using RosMaps = std::map<std::string, GridInFrame>;
 
+/** `map` with each cell split into `factor`² cells of its value, in the same
+ * frame, written as a map_server file in `dir` and read back (as a user's
+ * file would be). */
+GridInFrame finerMap(const GridInFrame& map, double factor, const std::string& dir, const std::string& name)
+{
+	GridInFrame fine = map;
+	const auto& g = map.grid;
+	fine.grid.setSize(g.getXMin(), g.getXMax(), g.getYMin(), g.getYMax(), float(g.getResolution() / factor));
+	for (unsigned y = 0; y < fine.grid.getSizeY(); ++y)
+		for (unsigned x = 0; x < fine.grid.getSizeX(); ++x)
+			fine.grid.setCell(
+				x, y, g.getCell(g.x2idx(fine.grid.idx2x(x)), g.y2idx(fine.grid.idx2y(y))));
+	std::string file = name;
+	std::replace(file.begin(), file.end(), '/', '_');
+	const std::string yaml = dir + "/" + file + ".yaml";
+	if (const std::string why = saveGridMap(fine, yaml); !why.empty()) throw std::runtime_error(why);
+	return loadGridMap(yaml);
+}
+
+/** One ordered pair: `truth` (metres, between the maps' frames) for a
+ * positive, none for a negative; displacements in cells of `cell_m`. */
 RosMapsRun runPair(
-	const BenchContext& ctx, const RosMaps& maps, const std::string& ref_place, const std::string& ref_name,
-	const std::string& other_name, const Similarity2D* truth_cells)
+	const BenchContext& ctx, const RosMaps& maps, double factor, const std::string& ref_place,
+	const std::string& ref_name, const std::string& other_name, const Similarity2D* truth, double cell_m)
 {
 	RosMapsRun run;
+	run.factor = factor;
 	run.place = ref_place;
 	run.ref = ref_name, run.other = other_name;
-	run.positive = truth_cells != nullptr;
+	run.positive = truth != nullptr;
 	const GridInFrame &ref = maps.at(ref_name), &other = maps.at(other_name);
 	mrpt::system::CTicTac clock;
 	const auto r = ctx.aligner().alignScaled(ref, other);
 	run.seconds = clock.Tac();
 	run.merged = r.success, run.confidence = r.confidence, run.message = r.message;
+	// The calibration data holds the files' pairs only.
+	const bool record = factor == 1.0;
 	if (!run.positive)
-		writeCandidates(ctx, "ros", run.ref, run.other, false, true, r, noTruth);
+	{
+		if (record) writeCandidates(ctx, "ros", run.ref, run.other, false, true, r, noTruth);
+	}
 	else
 	{
 		const auto points = occupiedPointsInMapFrame(other);
-		const Similarity2D truth = candidateMetric(ref, *truth_cells, other);
 		const auto displacement = [&](const Similarity2D& metric) {
 			double sum = 0;
-			for (const auto& p : points) sum += (metric(p) - truth(p)).norm();
-			return sum / std::max<size_t>(1, points.size()) / ref.grid.getResolution();
+			for (const auto& p : points) sum += (metric(p) - (*truth)(p)).norm();
+			return sum / std::max<size_t>(1, points.size()) / cell_m;
 		};
 		if (r.candidates.size())
 		{
@@ -164,21 +191,26 @@ RosMapsRun runPair(
 		}
 		// Each candidate judged as it would be reported (the finish), as the
 		// Halmstad pairs are.
-		const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
-		const auto& o = ctx.options;
-		writeCandidates(
-			ctx, "ros", run.ref, run.other, true, true, r,
-			[&](const Similarity2D& cells) {
-				const double e = displacement(candidateMetric(ref, cells, other));
-				return std::pair<double, bool>{e, e <= kRosRightCells};
-			},
-			[&](const auto& c) {
-				return finishBent(
-					*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(),
-					o.decision);
-			});
+		if (record)
+		{
+			const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
+			const auto& o = ctx.options;
+			writeCandidates(
+				ctx, "ros", run.ref, run.other, true, true, r,
+				[&](const Similarity2D& cells) {
+					const double e = displacement(candidateMetric(ref, cells, other));
+					return std::pair<double, bool>{e, e <= kRosRightCells};
+				},
+				[&](const auto& c) {
+					return finishBent(
+						*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence),
+						o.finishParams(), o.decision);
+				});
+		}
 	}
-	std::cout << "ros maps " << run.ref << " <- " << run.other << ": "
+	std::cout << "ros maps";
+	if (factor != 1.0) std::cout << " x" << factor << " finer";
+	std::cout << " " << run.ref << " <- " << run.other << ": "
 			  << (run.positive ? (run.merged ? (run.right ? "merged right" : "MERGED WRONG") : "refused")
 						   : (run.merged ? "MERGED (false)" : "refused (other place)"))
 			  << ", " << run.displacement_cells << " cells from the truth, confidence " << run.confidence << ", "
@@ -200,29 +232,48 @@ Similarity2D bruteForceRigid(const cv::Mat& ref_classes, const cv::Mat& other_cl
 	return Similarity2D(1, best.yaw, best.t);
 }
 
-std::vector<RosMapsRun> runRosMaps(const BenchContext& ctx)
+std::vector<RosMapsRun> runRosMaps(const BenchContext& ctx, const std::vector<double>& factors)
 {
-	RosMaps maps;
+	RosMaps files;
 	for (const RosPlace& place : kRosPlaces)
-		for (const auto& m : place.maps) maps.emplace(place.name + "/" + m, loadGridMap(yamlOf(ctx, place, m)));
-	std::vector<RosMapsRun> runs;
+		for (const auto& m : place.maps) files.emplace(place.name + "/" + m, loadGridMap(yamlOf(ctx, place, m)));
+	// The truth of each same-place pair (b's frame in a's, metres), from the files.
+	std::map<std::pair<std::string, std::string>, Similarity2D> truth;
 	for (const RosPlace& place : kRosPlaces)
 		for (size_t a = 0; a < place.maps.size(); ++a)
 			for (size_t b = a + 1; b < place.maps.size(); ++b)
 			{
 				const std::string ma = place.name + "/" + place.maps[a], mb = place.name + "/" + place.maps[b];
-				const Similarity2D b_to_a = bruteForceRigid(toClassImage(maps.at(ma).grid), toClassImage(maps.at(mb).grid));
-				const Similarity2D a_to_b = b_to_a.inverse();
-				runs.push_back(runPair(ctx, maps, place.name, ma, mb, &b_to_a));
-				runs.push_back(runPair(ctx, maps, place.name, mb, ma, &a_to_b));
+				const Similarity2D b_to_a_cells =
+					bruteForceRigid(toClassImage(files.at(ma).grid), toClassImage(files.at(mb).grid));
+				truth[{ma, mb}] = candidateMetric(files.at(ma), b_to_a_cells, files.at(mb));
+				truth[{mb, ma}] = truth[{ma, mb}].inverse();
 			}
-	for (const RosPlace& ref_place : kRosPlaces)
-		for (const RosPlace& other_place : kRosPlaces)
-			if (&ref_place != &other_place)
-				for (const auto& ref : ref_place.maps)
+	std::vector<RosMapsRun> runs;
+	for (const double factor : factors)
+	{
+		RosMaps maps = files;
+		std::string dir;
+		if (factor != 1.0)
+		{
+			dir = ctx.tempDir("ros_finer");
+			fs::create_directories(dir);
+			for (auto& [name, map] : maps) map = finerMap(files.at(name), factor, dir, name);
+		}
+		for (const RosPlace& ref_place : kRosPlaces)
+			for (const auto& ref : ref_place.maps)
+				for (const RosPlace& other_place : kRosPlaces)
 					for (const auto& other : other_place.maps)
+					{
+						const std::string mr = ref_place.name + "/" + ref, mo = other_place.name + "/" + other;
+						if (mr == mo) continue;
+						const auto t = truth.find({mr, mo});
+						const double cell_m = files.at(mr).grid.getResolution();
 						runs.push_back(runPair(
-							ctx, maps, ref_place.name, ref_place.name + "/" + ref, other_place.name + "/" + other, nullptr));
+							ctx, maps, factor, ref_place.name, mr, mo, t == truth.end() ? nullptr : &t->second, cell_m));
+					}
+		if (!dir.empty()) fs::remove_all(dir);
+	}
 	return runs;
 }
 
@@ -234,38 +285,48 @@ void writeRosMapsSection(std::ostream& md, const std::vector<RosMapsRun>& runs)
 		  "a brute-force search over every turn and shift finds (`bruteForceRigid`, bench/ros_maps.h). **Right** = "
 		  "merged with the other map's occupied cells within "
 	   << kRosRightCells
-	   << " cells (mean) of the truth. Every ordered pair of a place, and every map against every map of the other "
-		  "places (must not merge). Calibration data (`--calibration-data`, site `ros`).\n\n"
-	   << "| place | pairs | merged right | refused | merged wrong | displacement of the right [cells] | other places' maps merged | median time [s] |\n"
-	   << "|---|---|---|---|---|---|---|---|\n";
-	for (const RosPlace& place : kRosPlaces)
-	{
-		size_t pairs = 0, right = 0, refused = 0, wrong = 0, negatives = 0, false_merges = 0;
-		std::vector<double> disp, secs;
-		for (const auto& r : runs)
+	   << " cells of the files (mean) of the truth. Every ordered pair of a place, and every map against every map of "
+		  "the other places (must not merge). Calibration data (`--calibration-data`, site `ros`): the files' pairs. "
+		  "*Finer*: every map resampled "
+	   << kRosFinerFactor
+	   << "× finer (each cell split into cells of its value), written as map_server files stated at that "
+		  "resolution and read back: a lab mapped at 2 cm is in cells what a place 2.5× larger is at 5 cm (its walls "
+		  "keep their thickness, 2–3 cells, where a 2 cm lidar map draws them thinner). Never calibrated on.\n\n"
+	   << "| cells | place | pairs | merged right | refused | merged wrong | displacement of the right [cells of the files] | other places' maps merged | median time [s] |\n"
+	   << "|---|---|---|---|---|---|---|---|---|\n";
+	std::set<double> factors;
+	for (const auto& r : runs) factors.insert(r.factor);
+	for (const double factor : factors)
+		for (const RosPlace& place : kRosPlaces)
 		{
-			if (r.place != place.name) continue;
-			secs.push_back(r.seconds);
-			if (!r.positive)
+			size_t pairs = 0, right = 0, refused = 0, wrong = 0, negatives = 0, false_merges = 0;
+			std::vector<double> disp, secs;
+			for (const auto& r : runs)
 			{
-				++negatives, false_merges += r.merged;
-				continue;
+				if (r.place != place.name || r.factor != factor) continue;
+				secs.push_back(r.seconds);
+				if (!r.positive)
+				{
+					++negatives, false_merges += r.merged;
+					continue;
+				}
+				++pairs;
+				if (!r.merged) ++refused;
+				else if (r.right) ++right, disp.push_back(r.displacement_cells);
+				else ++wrong;
 			}
-			++pairs;
-			if (!r.merged) ++refused;
-			else if (r.right) ++right, disp.push_back(r.displacement_cells);
-			else ++wrong;
+			const auto [lo, hi] = disp.empty()
+				? std::pair<double, double>{NAN, NAN}
+				: std::pair<double, double>{*std::min_element(disp.begin(), disp.end()),
+											*std::max_element(disp.begin(), disp.end())};
+			char range[64];
+			std::snprintf(range, sizeof range, disp.empty() ? "–" : "%.1f–%.1f", lo, hi);
+			char time[32];
+			std::snprintf(time, sizeof time, "%.2f", median(secs));
+			md << "| " << (factor == 1.0 ? std::string("files") : "×" + std::to_string(factor).substr(0, 3) + " finer")
+			   << " | " << place.name << " | " << pairs << " | " << right << " | " << refused << " | " << wrong << " | "
+			   << range << " | " << false_merges << " / " << negatives << " | " << time << " |\n";
 		}
-		const auto [lo, hi] = disp.empty() ? std::pair<double, double>{NAN, NAN}
-										   : std::pair<double, double>{*std::min_element(disp.begin(), disp.end()),
-																	   *std::max_element(disp.begin(), disp.end())};
-		char range[64];
-		std::snprintf(range, sizeof range, disp.empty() ? "–" : "%.1f–%.1f", lo, hi);
-		char time[32];
-		std::snprintf(time, sizeof time, "%.2f", median(secs));
-		md << "| " << place.name << " | " << pairs << " | " << right << " | " << refused << " | " << wrong << " | "
-		   << range << " | " << false_merges << " / " << negatives << " | " << time << " |\n";
-	}
 }
 
 }  // namespace multires_bench
