@@ -89,7 +89,7 @@ struct DecisionParams
 {
 	/** score = B + chance_weight (B − C) − √(evidence / n) + feature_weight · min(F, cap) / cap */
 	double chance_weight = 1.0;
-	double evidence = 400;  //!< evidence discount [wall points]
+	double evidence = 300;  //!< evidence discount [wall points]
 	double feature_weight = 0.2;
 	double feature_cap = 10;
 	/** value = score + runner_up_weight (score − max(runner_up_floor, best rival's score)) */
@@ -102,7 +102,7 @@ struct DecisionParams
 	 * on Halmstad; at most 2 m at 5 cm cells, what the benchmark calls right. */
 	double distinct_shift = 40.0;
 	/** The decision value at confidence 0.5; ±0.1 (1 + runner_up_weight) spans 0..1. */
-	double threshold = 0.694;
+	double threshold = 0.782;
 	double min_confidence = 0.5;  //!< below it: not merged
 
 	/** Turned by more than this, a candidate is a rival (the far

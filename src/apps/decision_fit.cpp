@@ -66,7 +66,7 @@ constexpr double kMargin = 0.05;
 // benchmark still calls right; a candidate farther away places the map
 // elsewhere and must stay a rival.
 const std::vector<double> kChanceWeights{0.5, 1.0, 1.5};
-const std::vector<double> kEvidence{200, 400, 1000};
+const std::vector<double> kEvidence{200, 300, 400, 600, 1000};
 const std::vector<std::pair<double, double>> kFeatureTerms{{0.0, 20},  {0.1, 10}, {0.1, 20}, {0.1, 40}, {0.2, 10},
 														   {0.2, 20},  {0.2, 40}, {0.4, 10}, {0.4, 20}, {0.4, 40}};
 const std::vector<double> kRunnerUpWeights{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0};
