@@ -87,7 +87,7 @@ int halmstadOnly(const BenchContext& ctx, const std::string& sites, size_t negat
 
 int rosMapsOnly(const BenchContext& ctx)
 {
-	const auto runs = runRosMaps(ctx, {1.0, kRosFinerFactor});
+	const auto runs = runRosMaps(ctx, kRosFactors);
 	writeRosMapsSection(std::cout, runs);
 	const bool wrong = std::any_of(runs.begin(), runs.end(), [](const RosMapsRun& r) { return r.merged && !r.right; });
 	return wrong ? 1 : 0;
@@ -173,7 +173,7 @@ void runRealMaps(const BenchContext& ctx, FullRun& run)
 		run.floor_plans = runFloorPlans(data, data.sites(), ctx.options, dir);
 		run.coarser = runCoarserOther(data, data.sites(), kCoarserFactors, ctx.options, dir);
 		fs::remove_all(dir);
-		run.ros_maps = runRosMaps(ctx, {1.0, kRosFinerFactor});
+		run.ros_maps = runRosMaps(ctx, kRosFactors);
 		run.carpin = runCarpinMaps(ctx);
 	}
 	const std::string w = ctx.data + "/ros_maps/willow/";

@@ -572,7 +572,8 @@ void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 		   plans.merged_wrong + plans.negatives_merged == 0);
 	size_t ros_wrong = 0, ros_negatives = 0;
 	for (const auto& r : run.ros_maps) ros_wrong += r.merged && !r.right, ros_negatives += !r.positive;
-	target("0 merged wrong over the independent ROS maps, as filed and 2.5× finer: same place and other places",
+	target("0 merged wrong over the independent ROS maps, as filed and " + rosCellsLabel(kRosFinerFactor) +
+			   ": same place and other places",
 		   std::to_string(ros_wrong) + " (of " + std::to_string(run.ros_maps.size()) + " pairs, " +
 			   std::to_string(ros_negatives) + " of different places)",
 		   ros_wrong == 0);

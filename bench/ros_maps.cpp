@@ -16,6 +16,7 @@
 #include <iostream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 namespace multires_bench
@@ -252,14 +253,15 @@ std::vector<RosMapsRun> runRosMaps(const BenchContext& ctx, const std::vector<do
 	std::vector<RosMapsRun> runs;
 	for (const double factor : factors)
 	{
-		RosMaps maps = files;
+		RosMaps finer;
 		std::string dir;
 		if (factor != 1.0)
 		{
 			dir = ctx.tempDir("ros_finer");
 			fs::create_directories(dir);
-			for (auto& [name, map] : maps) map = finerMap(files.at(name), factor, dir, name);
+			for (const auto& [name, map] : files) finer.emplace(name, finerMap(map, factor, dir, name));
 		}
+		const RosMaps& maps = factor == 1.0 ? files : finer;
 		for (const RosPlace& ref_place : kRosPlaces)
 			for (const auto& ref : ref_place.maps)
 				for (const RosPlace& other_place : kRosPlaces)
@@ -277,6 +279,14 @@ std::vector<RosMapsRun> runRosMaps(const BenchContext& ctx, const std::vector<do
 	return runs;
 }
 
+std::string rosCellsLabel(double factor)
+{
+	if (factor == 1.0) return "files";
+	std::ostringstream label;
+	label << "×" << factor << " finer";
+	return label.str();
+}
+
 void writeRosMapsSection(std::ostream& md, const std::vector<RosMapsRun>& runs)
 {
 	md << "\n## Independent ROS maps (ros_maps, SOURCES.md 2b)\n\n"
@@ -290,8 +300,10 @@ void writeRosMapsSection(std::ostream& md, const std::vector<RosMapsRun>& runs)
 		  "*Finer*: every map resampled "
 	   << kRosFinerFactor
 	   << "× finer (each cell split into cells of its value), written as map_server files stated at that "
-		  "resolution and read back: a lab mapped at 2 cm is in cells what a place 2.5× larger is at 5 cm (its walls "
-		  "keep their thickness, 2–3 cells, where a 2 cm lidar map draws them thinner). Never calibrated on.\n\n"
+		  "resolution and read back: a lab mapped at 2 cm is in cells what a place "
+	   << kRosFinerFactor
+	   << "× larger is at 5 cm (its walls keep their thickness, 2–3 cells, where a 2 cm lidar map draws them "
+		  "thinner). Never calibrated on.\n\n"
 	   << "| cells | place | pairs | merged right | refused | merged wrong | displacement of the right [cells of the files] | other places' maps merged | median time [s] |\n"
 	   << "|---|---|---|---|---|---|---|---|---|\n";
 	std::set<double> factors;
@@ -323,8 +335,7 @@ void writeRosMapsSection(std::ostream& md, const std::vector<RosMapsRun>& runs)
 			std::snprintf(range, sizeof range, disp.empty() ? "–" : "%.1f–%.1f", lo, hi);
 			char time[32];
 			std::snprintf(time, sizeof time, "%.2f", median(secs));
-			md << "| " << (factor == 1.0 ? std::string("files") : "×" + std::to_string(factor).substr(0, 3) + " finer")
-			   << " | " << place.name << " | " << pairs << " | " << right << " | " << refused << " | " << wrong << " | "
+			md << "| " << rosCellsLabel(factor) << " | " << place.name << " | " << pairs << " | " << right << " | " << refused << " | " << wrong << " | "
 			   << range << " | " << false_merges << " / " << negatives << " | " << time << " |\n";
 		}
 }

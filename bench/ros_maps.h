@@ -33,6 +33,11 @@ constexpr double kRosRightCells = 10.0;
  * what a 2.5x larger place is at 5 cm; the walls keep their thickness in
  * metres (2-3 cells), which a 2 cm lidar map would draw thinner. */
 constexpr double kRosFinerFactor = 2.5;
+/** What the benchmark runs: the files, and the files kRosFinerFactor× finer. */
+inline const std::vector<double> kRosFactors = {1.0, kRosFinerFactor};
+
+/** "files", or "×2.5 finer": a row's cells in the report. */
+std::string rosCellsLabel(double factor);
 
 struct RosMapsRun
 {
