@@ -61,9 +61,14 @@ HalmstadRun runHalmstadPair(
 	if (retry)
 	{
 		// Why not: the search, or the evidence? The annotation as a start
-		// (these files' origins are 0: map frames are the grids' frames).
+		// (these files' origins are 0: map frames are the grids' frames),
+		// then the whole search: a start confident on its own would stop it
+		// (tracking), and the decision would not see the rivals that refused
+		// the pair.
 		const Similarity2D start = truthBetweenMapFrames(*truth, int(other_map.grid.getSizeY()), ref_rows);
-		const auto again = ctx.aligner().alignScaled(*ref_prepared, *other_prepared, start);
+		CScalingGridMapAligner searching = ctx.aligner();
+		searching.options.exhaustive_search = true;
+		const auto again = searching.alignScaled(*ref_prepared, *other_prepared, start);
 		run.retried_from_truth = true;
 		run.right_from_truth = again.success && judge(again.metric, *truth, other_map, ref_rows).right;
 	}

@@ -80,7 +80,7 @@ int halmstadOnly(const BenchContext& ctx, const std::string& sites, size_t negat
 	for (const auto& [site, t] : per_site)
 		std::cout << "halmstad " << site << ": " << t.right << "/" << t.pairs << " merged right, " << t.wrong
 				  << " merged wrong; of the others, from the annotation: " << t.search_missed
-				  << " merged right (the search missed them), " << t.evidence_weak << " refused (evidence too weak)\n";
+				  << " merged right (the search missed them), " << t.evidence_weak << " refused (weak evidence or a rival)\n";
 	std::cout << "halmstad negatives: " << false_merges << "/" << negatives << " merged\n";
 	return wrong + false_merges == 0 ? 0 : 1;
 }

@@ -359,9 +359,10 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 		  "`rms_px`, 40 px). E5 and HIH are the calibration sites (the decision was tuned on them, "
 		  "`decision-fit`); **F5 and KPT4A are the acceptance set: never tuned on**. "
 		  "*Not merged right, from the annotation*: each such pair aligned again with the annotated similarity as "
-		  "its first hypothesis (then the usual search and decision): merged right then, the search missed it; "
-		  "refused again, what its walls say is too weak to merge on.\n\n"
-	   << "| site | role | pairs | merged right | refused | merged wrong | not merged right, from the annotation: merged right (search missed) | refused (evidence too weak) | median displacement [px] | median corr. RMS [px] | median runtime [s] | MRPT (sample, 30 s limit) |\n"
+		  "its first hypothesis, then the whole search (exhaustive: a start confident on its own does not stop it) "
+		  "and the decision: merged right then, the search missed it; refused again, what its walls say is too "
+		  "weak to merge on, or a placement elsewhere fits nearly as well.\n\n"
+	   << "| site | role | pairs | merged right | refused | merged wrong | not merged right, from the annotation: merged right (search missed) | refused (weak evidence or a rival) | median displacement [px] | median corr. RMS [px] | median runtime [s] | MRPT (sample, 30 s limit) |\n"
 	   << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 	for (const auto& site : {"E5", "HIH", "F5", "KPT4A"})
 	{
