@@ -252,12 +252,17 @@ std::vector<Eigen::Vector2d> occupiedPx(const GridInFrame& map)
 
 double meanDisplacementPx(const Similarity2D& est, const Similarity2D& truth_px, const GridInFrame& other, int ref_rows)
 {
-	if (!est.isFinite()) return NAN;
-	const int src_rows = static_cast<int>(other.grid.getSizeY());
-	const std::vector<Eigen::Vector2d> occupied = occupiedPx(other);
+	return meanDisplacementPx(est, truth_px, occupiedPx(other), static_cast<int>(other.grid.getSizeY()), ref_rows);
+}
+
+double meanDisplacementPx(
+	const Similarity2D& est, const Similarity2D& truth_px, const std::vector<Eigen::Vector2d>& src_px, int src_rows,
+	int ref_rows)
+{
+	if (!est.isFinite() || src_px.empty()) return NAN;
 	double sum = 0;
-	for (const auto& px : occupied) sum += (metricToPx(est(pxToMetric(px, src_rows)), ref_rows) - truth_px(px)).norm();
-	return occupied.empty() ? NAN : sum / occupied.size();
+	for (const auto& px : src_px) sum += (metricToPx(est(pxToMetric(px, src_rows)), ref_rows) - truth_px(px)).norm();
+	return sum / src_px.size();
 }
 
 double annotationDisagreementPx(

@@ -118,6 +118,11 @@ Similarity2D candidateMetric(const GridInFrame& ref, const Similarity2D& cells, 
 /** Mean distance of `other`'s occupied pixels between where `est` (between
  * the maps' frames) and `truth_px` (image pixels) put them, px of REF. */
 double meanDisplacementPx(const Similarity2D& est, const Similarity2D& truth_px, const GridInFrame& other, int ref_rows);
+/** The same over `src_px`, pixels of a source image of `src_rows` rows
+ * whose frame is the map frame `est` starts from. */
+double meanDisplacementPx(
+	const Similarity2D& est, const Similarity2D& truth_px, const std::vector<Eigen::Vector2d>& src_px, int src_rows,
+	int ref_rows);
 
 /** How much the annotations disagree among themselves about where `maps[k]`
  * lies in `maps[0]` (k ≥ 1): the mean distance over its occupied pixels

@@ -5,7 +5,7 @@
 //   multires_bench --quick  --out DIR     a few pairs (CI: the bench cannot rot)
 //   multires_bench --out DIR              the full run (bench/README.md)
 // One file per experiment (carmen, halmstad_pairs, floor_plans,
-// coarser_other, scaling, fleets, halmstad_fleets, live_fleet, calibration),
+// coarser_other, partial_maps, scaling, fleets, halmstad_fleets, live_fleet, calibration),
 // the report apart (report.cpp); this file picks what to run.
 
 #include "calibration.h"
@@ -17,6 +17,7 @@
 #include "halmstad_fleets.h"
 #include "halmstad_pairs.h"
 #include "live_fleet.h"
+#include "partial_maps.h"
 #include "report.h"
 #include "scaling.h"
 
@@ -48,6 +49,16 @@ std::vector<std::string> siteList(const std::string& comma_separated)
 }
 
 // ---------------------------------------------------------------- one section alone
+int partialOnly(const BenchContext& ctx, const std::string& sites)
+{
+	const std::string dir = ctx.tempDir("partial");
+	const auto runs = runPartialMaps(HalmstadData(ctx.data + "/halmstad"), siteList(sites), ctx.options, dir);
+	fs::remove_all(dir);
+	writePartialSection(std::cout, runs);
+	const PartialTotals t = partialTotals(runs);
+	return t.wrong + t.negatives_merged == 0 ? 0 : 1;
+}
+
 int coarserOnly(const BenchContext& ctx, const std::string& sites)
 {
 	const std::string dir = ctx.tempDir("coarser");
@@ -154,7 +165,7 @@ void runMatrices(const BenchContext& ctx, FullRun& run)
 }
 
 /** Halmstad sensor pairs and cross-site negatives, floor plans, OTHER
- * recorded coarser, the independent ROS maps, Carpin's maps and the Willow
+ * recorded coarser, partial maps, the independent ROS maps, Carpin's maps and the Willow
  * pair. */
 void runRealMaps(const BenchContext& ctx, FullRun& run)
 {
@@ -172,6 +183,7 @@ void runRealMaps(const BenchContext& ctx, FullRun& run)
 		const std::string dir = ctx.tempDir("plans");
 		run.floor_plans = runFloorPlans(data, data.sites(), ctx.options, dir);
 		run.coarser = runCoarserOther(data, data.sites(), kCoarserFactors, ctx.options, dir);
+		run.partial = runPartialMaps(data, data.sites(), ctx.options, dir);
 		fs::remove_all(dir);
 		run.ros_maps = runRosMaps(ctx, kRosFactors);
 		run.carpin = runCarpinMaps(ctx);
@@ -238,6 +250,9 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<std::string> coarser_arg(
 		"", "coarser-only", "only the coarser-OTHER section (×2, ×3.3) on these sites (e.g. F5,KPT4A)", false, "", "SITES",
 		cmd);
+	TCLAP::ValueArg<std::string> partial_arg(
+		"", "partial-only", "only the partial-maps section (halves of these sites' sensor maps, e.g. E5,HIH)", false, "",
+		"SITES", cmd);
 	TCLAP::ValueArg<std::string> floor_plans_arg(
 		"", "floor-plans-only", "only the floor-plan section, sensor maps of these sites (e.g. E5,HIH) on every plan", false,
 		"", "SITES", cmd);
@@ -319,6 +334,7 @@ int main(int argc, char** argv)
 			return 0;
 		}
 		if (coarser_arg.isSet()) return coarserOnly(ctx, coarser_arg.getValue());
+		if (partial_arg.isSet()) return partialOnly(ctx, partial_arg.getValue());
 		if (floor_plans_arg.isSet()) return floorPlansOnly(ctx, floor_plans_arg.getValue());
 		if (halmstad_arg.isSet()) return halmstadOnly(ctx, halmstad_arg.getValue(), negatives_arg.getValue());
 		if (sets_arg.isSet()) return runAccuracySets(ctx, sets_arg.getValue());

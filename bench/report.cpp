@@ -384,6 +384,7 @@ void writeHalmstadSection(std::ostream& md, const FullRun& run, const Facts& f)
 	   << " (reference and tolerance: README, test_real_maps).\n";
 	if (!floor_plans.empty()) writeFloorPlanSection(md, floor_plans);
 	if (!coarser.empty()) writeCoarserSection(md, coarser);
+	if (!run.partial.empty()) writePartialSection(md, run.partial);
 	if (!run.ros_maps.empty()) writeRosMapsSection(md, run.ros_maps);
 	if (!run.carpin.runs.empty()) writeCarpinSection(md, run.carpin);
 }
@@ -578,6 +579,12 @@ void writeRealMapTargets(std::ostream& md, const FullRun& run, const Facts& f)
 		   std::to_string(ros_wrong) + " (of " + std::to_string(run.ros_maps.size()) + " pairs, " +
 			   std::to_string(ros_negatives) + " of different places)",
 		   ros_wrong == 0);
+	const PartialTotals partial = partialTotals(run.partial);
+	target("0 merged wrong over partial maps (halves of the Halmstad sensor maps): same site and other sites",
+		   std::to_string(partial.wrong + partial.negatives_merged) + " (of " +
+			   std::to_string(partial.positives + partial.negatives) + " pairs, " +
+			   std::to_string(partial.negatives) + " of other sites)",
+		   partial.wrong + partial.negatives_merged == 0);
 	target("0 merged wrong over Carpin's maps (never tuned on): same place and other places",
 		   std::to_string(carpinWrongMerges(run.carpin)) + " (of " + std::to_string(run.carpin.runs.size()) + " pairs)",
 		   carpinWrongMerges(run.carpin) == 0);

@@ -5,6 +5,7 @@
 #include "carmen.h"
 #include "carpin_maps.h"
 #include "coarser_other.h"
+#include "partial_maps.h"
 #include "fleets.h"
 #include "floor_plans.h"
 #include "halmstad_fleets.h"
@@ -28,6 +29,7 @@ struct FullRun
 	std::vector<HalmstadRun> halmstad;
 	std::vector<FloorPlanRun> floor_plans;
 	std::vector<CoarserRun> coarser;
+	std::vector<PartialRun> partial;
 	std::vector<RosMapsRun> ros_maps;
 	CarpinResult carpin;
 	CScalingGridMapAligner::TReturnInfo willow;

@@ -18,6 +18,7 @@
 
 #include "../bench/carpin_data.h"
 #include "../bench/halmstad.h"
+#include "../bench/partial_maps.h"
 #include "test_data.h"
 
 using namespace multires_map_merge;
@@ -252,6 +253,29 @@ TEST(RealMaps, HalmstadFleetAtMixedCellSizesPlacesAChainedMapAsCloseAsADirectOne
 	// disagree by about 2 px on HIH (REPORT, "annotations' own disagreement").
 	EXPECT_LE(worst_joint, worst_tree + 1.0);
 	EXPECT_LE(worst_chained, std::max(worst_direct, 5.0) * 1.25);
+}
+
+// A robot that explored part of the building: half of a sensor map, a
+// map_server file of its own size whose origin says where the half lies,
+// placed on another robot's whole map and judged on the half's own walls;
+// the same half against another building's map refused.
+TEST(RealMaps, HalmstadHalfOfAMapPlacedOnAnotherRobotsWholeMap)
+{
+	REQUIRE_HALMSTAD();
+	const auto half = multires_bench::writeHalf(*halmstad(), "E5_01", 1, dir());
+	const GridInFrame ref = loadGridMap(halmstad()->yaml("E5_02", dir())), other = loadGridMap(half.yaml);
+	ASSERT_FALSE(other.originIsIdentity());
+	ASSERT_LT(other.grid.getSizeX() * other.grid.getSizeY(), ref.grid.getSizeX() * ref.grid.getSizeY() / 2);
+	const auto res = CScalingGridMapAligner().alignScaled(ref, other);
+	ASSERT_TRUE(res.success) << res.message;
+	const auto* truth = halmstad()->pair("E5_01", "E5_02");
+	ASSERT_NE(truth, nullptr);
+	EXPECT_LE(
+		multires_bench::meanDisplacementPx(
+			res.metric, truth->src_to_dst_px, half.occupied, half.whole_rows, int(ref.grid.getSizeY())),
+		20);
+	const auto elsewhere = CScalingGridMapAligner().alignScaled(loadGridMap(halmstad()->yaml("F5_01", dir())), other);
+	EXPECT_FALSE(elsewhere.success) << "confidence " << elsewhere.confidence;
 }
 
 TEST(RealMaps, HalmstadDifferentBuildingsAreRefused)
