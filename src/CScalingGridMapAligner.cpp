@@ -247,6 +247,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	if (options.structure_search && !info.tracked && (!sure || options.exhaustive_search))
 		pair_search::refineStructureHypotheses(ctx, search);
 	Decision d = decide(pair_search::decisionInput(search.candidates), decision);
+	// A merge is decided against every rival: those the screen stopped on
+	// their samples are refined in full first (PairSearch.h).
+	if (d.merged && d.best && !info.tracked && pair_search::refineScreenedRivals(ctx, search, *d.best) > 0)
+		d = decide(pair_search::decisionInput(search.candidates), decision);
 
 	// 5. The mirror check (mirror_check): a merge that does not rest on
 	// coinciding cells rests on walls agreeing, which a mirror image can reach

@@ -418,6 +418,40 @@ void refineStructureHypotheses(const PairContext& c, SearchState& state)
 	refineAll(c, state, hyps);
 }
 
+size_t refineScreenedRivals(const PairContext& c, SearchState& state, size_t best)
+{
+	const DecisionParams& d = c.options.decision;
+	const Placement at = state.candidates[best].placement();
+	std::vector<size_t> rivals;
+	for (size_t i = 0; i < state.candidates.size(); ++i)
+	{
+		const Aligner::TCandidate& cand = state.candidates[i];
+		if (cand.screened && !cand.mirrored && cand.score >= d.runner_up_floor - c.options.screen_margin &&
+			d.areRivals(at, cand.placement()))
+			rivals.push_back(i);
+	}
+	std::vector<Refined> done(rivals.size());
+	cv::parallel_for_(cv::Range(0, int(rivals.size())), [&](const cv::Range& range) {
+		for (int k = range.start; k < range.end; ++k)
+		{
+			const Hypothesis& h = state.refinements[rivals[k]].h;
+			done[k] = refineInFull(c, h, screenOne(c, h));
+		}
+	});
+	for (size_t k = 0; k < rivals.size(); ++k)
+	{
+		state.stage_seconds["icp"] += done[k].icp_s;
+		state.stage_seconds["verify"] += done[k].verify_s;
+		if (!done[k].valid) continue;
+		state.candidates[rivals[k]] = done[k].cand;
+		state.refinements[rivals[k]].r = done[k].r;
+		debug(c, [&](std::ostream& out) {
+			out << "screened rival refined in full: " << done[k].r.transform << " score " << done[k].cand.score;
+		});
+	}
+	return rivals.size();
+}
+
 double bestScore(const std::vector<Aligner::TCandidate>& candidates)
 {
 	double best = -std::numeric_limits<double>::infinity();
