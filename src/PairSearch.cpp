@@ -228,9 +228,9 @@ Refined refineInFull(const PairContext& c, const Hypothesis& h, const Screen& s)
  * Raised as better candidates are found (relevantScore only rises). Never
  * below the lowest mergeable score (less the margin): a rival between the
  * floor and that bar, which would lower a marginal best's value, is
- * screened away. Counted at their sample scores on the calibration data,
- * such rivals change one merge in about 340 (a right one, refused), at
- * about 40 % more full judgements. */
+ * screened away here (seeking them in every pair would cost about 40 %
+ * more full judgements); a pair about to merge refines them after all
+ * (refineScreenedRivals). */
 double screenBar(const PairContext& c, const SearchState& state)
 {
 	const auto& o = c.options;
