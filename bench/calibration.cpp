@@ -4,6 +4,7 @@
 #include "coarser_other.h"
 #include "halmstad_pairs.h"
 #include "live_fleet.h"
+#include "partial_maps.h"
 #include "ros_maps.h"
 
 #include <multires_map_merge/Finish.h>
@@ -98,6 +99,26 @@ void runExtraCalibrationNegatives(const BenchContext& ctx, const HalmstadData& d
 				}
 }
 
+/** A calibration pair's names in candidates.csv. */
+struct PairNames
+{
+	std::string site, ref, other;
+	bool positive;
+};
+
+/** The pair's candidates, each judged where the aligner would report it if
+ * decided on (the bent finish, Finish.h). */
+void writeFinishedCandidates(const BenchContext& ctx, const PairNames& names, const GridInFrame& ref,
+	const GridInFrame& other, const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of)
+{
+	const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
+	const auto& o = ctx.options;
+	writeCandidates(ctx, names.site, names.ref, names.other, names.positive, true, r, error_of, [&](const auto& c) {
+		return finishBent(
+			*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision);
+	});
+}
+
 /** Calibration pairs of the kind the package exists for: each E5 and HIH
  * pair (REF = the later map) with OTHER recorded as a coarser grid whose
  * stated resolution is wrong (the coarser-OTHER section's maps). Each
@@ -107,13 +128,9 @@ void runCoarserCalibrationPairs(const BenchContext& ctx, const HalmstadData& dat
 	const std::string dir = ctx.tempDir("coarser");
 	const auto sink = [&ctx](const CoarserRun& run, const GridInFrame& ref, const GridInFrame& other,
 						  const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of) {
-		const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
-		const auto& o = ctx.options;
 		std::ostringstream other_name;
 		other_name << run.other << "_x" << run.factor;
-		writeCandidates(ctx, run.site, run.ref, other_name.str(), true, true, r, error_of, [&](const auto& c) {
-			return finishBent(*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision);
-		});
+		writeFinishedCandidates(ctx, {run.site, run.ref, other_name.str(), true}, ref, other, r, error_of);
 	};
 	runCoarserOther(data, {"E5", "HIH"}, kCoarserFactors, ctx.options, dir, sink);
 	fs::remove_all(dir);
@@ -129,6 +146,24 @@ void runFloorPlanCalibrationPairs(const BenchContext& ctx, const HalmstadData& d
 		for (const auto& sensor : data.sensorMaps(site))
 			for (const auto& plan_site : data.sites())
 				runHalmstadPair(ctx, data, HalmstadData::floorPlan(plan_site), sensor, dir);
+	fs::remove_all(dir);
+}
+
+/** Partial maps: each half of the earlier map of every E5 and HIH pair on
+ * the later map (positives, judged against the annotation on the half's own
+ * walls), and every such half on the first map of each other site
+ * (negatives), as the partial-maps section aligns them. A half REF saw
+ * little of is a positive whose best candidate is often wrong: the decision
+ * must refuse it. */
+void runPartialCalibrationPairs(const BenchContext& ctx, const HalmstadData& data)
+{
+	const std::string dir = ctx.tempDir("partial");
+	const auto sink = [&ctx](const PartialRun& run, const GridInFrame& ref, const GridInFrame& half,
+						  const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of) {
+		const std::string other = run.other + (run.half == kPartialHalves.front() ? "_half1" : "_half2");
+		writeFinishedCandidates(ctx, {run.site, run.ref, other, run.positive}, ref, half, r, error_of);
+	};
+	runPartialMaps(data, {"E5", "HIH"}, ctx.options, dir, sink);
 	fs::remove_all(dir);
 }
 
@@ -174,8 +209,8 @@ void runReverseCalibrationPositives(const BenchContext& ctx, const HalmstadData&
 void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts)
 {
 	const HalmstadData data(ctx.data + "/halmstad");
-	const bool everything =
-		!parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs && !parts.floor_plan_pairs && !parts.ros_pairs;
+	const bool everything = !parts.extra_negatives && !parts.live_pairs && !parts.coarser_pairs &&
+		!parts.floor_plan_pairs && !parts.ros_pairs && !parts.partial_pairs;
 	if (everything)
 	{
 		runHalmstad(ctx, data, {"E5", "HIH"}, parts.negatives_per_map);
@@ -188,6 +223,7 @@ void writeCalibrationData(const BenchContext& ctx, const CalibrationParts& parts
 	if (everything || parts.coarser_pairs) runCoarserCalibrationPairs(ctx, data);
 	if (everything || parts.floor_plan_pairs) runFloorPlanCalibrationPairs(ctx, data);
 	if (everything || parts.ros_pairs) runRosMaps(ctx);
+	if (everything || parts.partial_pairs) runPartialCalibrationPairs(ctx, data);
 }
 
 }  // namespace multires_bench

@@ -5,7 +5,8 @@
 // decision-fit. Calibration sites only (Halmstad E5, HIH),
 // their cross-site negatives in both orders, CARMEN negatives, mirror images,
 // the live fleet's growing maps, OTHER recorded coarser, the sensor maps
-// on the floor plans and the independent ROS maps (ros_maps.h).
+// on the floor plans, the independent ROS maps (ros_maps.h) and halves of
+// the E5 and HIH maps (partial_maps.h).
 
 #include "context.h"
 
@@ -14,7 +15,8 @@ namespace multires_bench
 /** Which parts; all of them when none is set. */
 struct CalibrationParts
 {
-	bool extra_negatives = false, live_pairs = false, coarser_pairs = false, floor_plan_pairs = false, ros_pairs = false;
+	bool extra_negatives = false, live_pairs = false, coarser_pairs = false, floor_plan_pairs = false, ros_pairs = false,
+		 partial_pairs = false;
 	size_t negatives_per_map = 8;
 };
 

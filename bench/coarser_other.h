@@ -29,8 +29,6 @@ struct CoarserRun
 	double seconds = 0;
 };
 
-/** A candidate's displacement against the annotation [px] and whether that is right. */
-using CandidateError = std::function<std::pair<double, bool>(const multires_map_merge::Similarity2D& cells)>;
 /** Called after each pair with its maps, its result and how to judge any of
  * its candidates (cells of REF ← cells of the coarse OTHER): the calibration
  * data's writer. */

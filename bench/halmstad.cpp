@@ -297,7 +297,7 @@ HalmstadOutcome judge(const Similarity2D& est, const HalmstadPair& p, const Grid
 	for (const auto& [s, d] : p.inliers)
 		se += (metricToPx(est(pxToMetric(s, src_rows)), ref_rows) - d).squaredNorm();
 	if (!p.inliers.empty()) o.corr_rms_px = std::sqrt(se / p.inliers.size());
-	o.right = o.mean_displacement_px <= 40 && o.corr_rms_px <= std::max(2 * p.rms_px, 40.0);
+	o.right = o.mean_displacement_px <= kRightPx && o.corr_rms_px <= std::max(2 * p.rms_px, kRightPx);
 	return o;
 }
 

@@ -14,6 +14,7 @@
 #include <multires_map_merge/Similarity2D.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -131,9 +132,19 @@ double meanDisplacementPx(
 double annotationDisagreementPx(const HalmstadData& data, const std::vector<std::string>& maps,
 	const std::vector<GridInFrame>& loaded);
 
+/** A placement is right within this mean displacement of OTHER's occupied
+ * pixels from the annotation's [px of 5 cm]: 2 m, what separate SLAM runs
+ * of one building bend apart. */
+constexpr double kRightPx = 40;
+
+/** A candidate's displacement against the annotation [px] and whether that
+ * is right (cells of REF ← cells of OTHER as aligned; never right for a
+ * pair of different sites). */
+using CandidateError = std::function<std::pair<double, bool>(const Similarity2D& cells)>;
+
 /** Judges a transform between the maps' frames (x_ref = est(x_other); REF =
  * dst, OTHER = src, both loaded from the yamls) against the annotation:
- * mean displacement ≤ 40 px and correspondence RMS ≤ max(2·rms_px, 40 px). */
+ * mean displacement ≤ kRightPx and correspondence RMS ≤ max(2·rms_px, kRightPx). */
 HalmstadOutcome judge(const Similarity2D& est, const HalmstadPair& p, const GridInFrame& other, int ref_rows);
 
 /** The annotation as a transform between the maps' frames (metres), for maps

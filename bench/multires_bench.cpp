@@ -245,6 +245,8 @@ int main(int argc, char** argv)
 		"", "coarser-pairs-only", "with --calibration-data: only the E5 and HIH pairs with OTHER recorded coarser", cmd);
 	TCLAP::SwitchArg floor_plan_pairs_arg(
 		"", "floor-plan-pairs-only", "with --calibration-data: only the E5 and HIH sensor maps on every site's floor plan", cmd);
+	TCLAP::SwitchArg partial_pairs_arg(
+		"", "partial-pairs-only", "with --calibration-data: only the halves of the E5 and HIH maps (partial maps)", cmd);
 	TCLAP::SwitchArg live_pairs_arg(
 		"", "live-pairs-only", "with --calibration-data: only the live fleet's growing maps, pair by pair", cmd);
 	TCLAP::ValueArg<std::string> coarser_arg(
@@ -328,8 +330,12 @@ int main(int argc, char** argv)
 			// screen's included), of every pair, not on those a decision kept.
 			ctx.options.exhaustive_search = true;
 			ctx.calibration_only = true;
-			writeCalibrationData(ctx, {extra_arg.getValue(), live_pairs_arg.getValue(), coarser_pairs_arg.getValue(),
-									   floor_plan_pairs_arg.getValue(), ros_maps_arg.getValue(), size_t(negatives_arg.getValue())});
+			CalibrationParts parts;
+			parts.extra_negatives = extra_arg.getValue(), parts.live_pairs = live_pairs_arg.getValue();
+			parts.coarser_pairs = coarser_pairs_arg.getValue(), parts.floor_plan_pairs = floor_plan_pairs_arg.getValue();
+			parts.ros_pairs = ros_maps_arg.getValue(), parts.partial_pairs = partial_pairs_arg.getValue();
+			parts.negatives_per_map = size_t(negatives_arg.getValue());
+			writeCalibrationData(ctx, parts);
 			std::cout << "wrote " << out << "/candidates.csv" << std::endl;
 			return 0;
 		}

@@ -6,7 +6,8 @@
 // half lies in the whole map's frame. OTHER = a half of the earlier map of
 // every same-site pair, REF = the later map, judged against the annotation
 // on the half's own occupied pixels; and every half against the first map of
-// each other site (must not merge). Never calibrated on.
+// each other site (must not merge). Calibration data holds the calibration
+// sites' halves (E5, HIH: calibration.h); F5 and KPT4A's are acceptance.
 
 #include "halmstad.h"
 
@@ -41,7 +42,7 @@ struct PartialRun
 	std::string site, ref, other, half;
 	bool positive = false;  //!< same site: the annotation says where the half lies
 	bool merged = false;
-	bool right = false;  //!< merged with the half's occupied pixels ≤ 40 px from the annotation (mean)
+	bool right = false;  //!< merged with the half's occupied pixels ≤ kRightPx from the annotation (mean)
 	double displacement_px = NAN;
 	/** Share of the half's occupied pixels that the annotation puts on REF's
 	 * known space: how much of the half REF saw at all. */
@@ -49,11 +50,17 @@ struct PartialRun
 	double seconds = 0;
 };
 
+/** Called after each pair with its maps, its result and how to judge any of
+ * its candidates: the calibration data's writer. */
+using PartialCandidatesSink = std::function<void(const PartialRun&, const GridInFrame& ref, const GridInFrame& half,
+	const multires_map_merge::CScalingGridMapAligner::TReturnInfo&, const CandidateError&)>;
+
 /** Every same-site pair of `sites` with OTHER cut in halves, and every half
  * against the first sensor map of each other site of the data set. */
 std::vector<PartialRun> runPartialMaps(
 	const HalmstadData& data, const std::vector<std::string>& sites,
-	const multires_map_merge::CScalingGridMapAligner::TConfigParams& options, const std::string& dir);
+	const multires_map_merge::CScalingGridMapAligner::TConfigParams& options, const std::string& dir,
+	const PartialCandidatesSink& sink = {});
 
 /** How far into REF a half must lie to count among the pairs REF mostly saw. */
 constexpr double kMostlyInside = 0.5;

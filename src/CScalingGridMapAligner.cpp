@@ -248,8 +248,10 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 		pair_search::refineStructureHypotheses(ctx, search);
 	Decision d = decide(pair_search::decisionInput(search.candidates), decision);
 	// A merge is decided against every rival: those the screen stopped on
-	// their samples are refined in full first (PairSearch.h).
-	if (d.merged && d.best && !info.tracked && pair_search::refineScreenedRivals(ctx, search, *d.best) > 0)
+	// their samples are refined in full first (PairSearch.h). (In
+	// calibration data, for every pair's best: a refit may merge it.)
+	if (d.best && (d.merged || options.exhaustive_search) && !info.tracked &&
+		pair_search::refineScreenedRivals(ctx, search, *d.best) > 0)
 		d = decide(pair_search::decisionInput(search.candidates), decision);
 
 	// 5. The mirror check (mirror_check): a merge that does not rest on

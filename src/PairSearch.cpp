@@ -101,6 +101,13 @@ Aligner::TCandidate candidateOf(
 	return cand;
 }
 
+/** On a sample, near enough to coinciding cells that a full refinement starts
+ * from the hypothesis, not from the sample's result (refineInFull). */
+bool mayBeExactOnScreen(double rmse_coarse, const Evidence& e)
+{
+	return rmse_coarse < kExactMaxRmse && e.tolerant_consistency > kExactMinScreenConsistency;
+}
+
 Screen screenOne(const PairContext& c, const Hypothesis& h)
 {
 	Screen s;
@@ -121,8 +128,21 @@ Screen screenOne(const PairContext& c, const Hypothesis& h)
 			<< s.judged.evidence.bent_consistency << " chance " << s.judged.evidence.chance_consistency << " score "
 			<< s.judged.score;
 	});
-	s.may_be_exact = s.rmse_coarse < kExactMaxRmse && s.judged.evidence.tolerant_consistency > kExactMinScreenConsistency;
+	s.may_be_exact = mayBeExactOnScreen(s.rmse_coarse, s.judged.evidence);
 	s.valid = true;
+	return s;
+}
+
+/** The screen a screened candidate went through, from what it kept (its
+ * sample result and evidence): refining it in full later needs no second
+ * screen. Its times were counted when it ran. */
+Screen storedScreen(const Aligner::TCandidate& cand, const TsICPResult& quick)
+{
+	Screen s;
+	s.ran = s.valid = true;
+	s.quick = quick;
+	s.rmse_coarse = cand.rmse_coarse_cells;
+	s.may_be_exact = mayBeExactOnScreen(s.rmse_coarse, cand.evidence);
 	return s;
 }
 
@@ -434,8 +454,8 @@ size_t refineScreenedRivals(const PairContext& c, SearchState& state, size_t bes
 	cv::parallel_for_(cv::Range(0, int(rivals.size())), [&](const cv::Range& range) {
 		for (int k = range.start; k < range.end; ++k)
 		{
-			const Hypothesis& h = state.refinements[rivals[k]].h;
-			done[k] = refineInFull(c, h, screenOne(c, h));
+			const Refinement& screened = state.refinements[rivals[k]];
+			done[k] = refineInFull(c, screened.h, storedScreen(state.candidates[rivals[k]], screened.r));
 		}
 	});
 	for (size_t k = 0; k < rivals.size(); ++k)

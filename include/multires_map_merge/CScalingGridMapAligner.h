@@ -68,7 +68,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		bool structure_search = true;
 		/** Refine every hypothesis (up to max_hypotheses) and always search
 		 * the structure, even once the maps are found to coincide or a
-		 * candidate is confident: what calibration data is made with. */
+		 * candidate is confident, and refine the screened rivals of every
+		 * pair's best: what calibration data is made with. */
 		bool exhaustive_search = false;
 		/** Before a pair is merged on its walls agreeing (not on coinciding
 		 * cells: exact_confidence), the other map is aligned once more
