@@ -251,7 +251,7 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 	// their samples are refined in full first (PairSearch.h). (In
 	// calibration data, for every pair's best: a refit may merge it.)
 	if (d.best && (d.merged || options.exhaustive_search) && !info.tracked &&
-		pair_search::refineScreenedRivals(ctx, search, *d.best) > 0)
+		pair_search::refineScreenedRivals(ctx, search, search.candidates[*d.best].placement()) > 0)
 		d = decide(pair_search::decisionInput(search.candidates), decision);
 
 	// 5. The mirror check (mirror_check): a merge that does not rest on
@@ -318,6 +318,9 @@ double CScalingGridMapAligner::mirrorPass(const TPreparedMap& ref, const TPrepar
 		? lowest
 		: std::max(lowest, options.decision.relevantScore(pair_search::bestScore(search.candidates)));
 	pair_search::refineFeatureHypotheses(ctx, mirror);
+	// Every mirrored candidate is a rival: those its screen stopped between
+	// the floor and the bar are refined too (refineScreenedRivals).
+	pair_search::refineScreenedRivals(ctx, mirror, std::nullopt);
 	double best = std::numeric_limits<double>::quiet_NaN();
 	for (size_t i = 0; i < mirror.candidates.size(); ++i)
 	{

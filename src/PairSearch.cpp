@@ -438,16 +438,15 @@ void refineStructureHypotheses(const PairContext& c, SearchState& state)
 	refineAll(c, state, hyps);
 }
 
-size_t refineScreenedRivals(const PairContext& c, SearchState& state, size_t best)
+size_t refineScreenedRivals(const PairContext& c, SearchState& state, const std::optional<Placement>& of)
 {
 	const DecisionParams& d = c.options.decision;
-	const Placement at = state.candidates[best].placement();
 	std::vector<size_t> rivals;
 	for (size_t i = 0; i < state.candidates.size(); ++i)
 	{
 		const Aligner::TCandidate& cand = state.candidates[i];
-		if (cand.screened && !cand.mirrored && cand.score >= d.runner_up_floor - c.options.screen_margin &&
-			d.areRivals(at, cand.placement()))
+		if (cand.screened && cand.score >= d.runner_up_floor - c.options.screen_margin &&
+			(!of || d.areRivals(*of, cand.placement())))
 			rivals.push_back(i);
 	}
 	std::vector<Refined> done(rivals.size());

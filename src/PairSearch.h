@@ -95,14 +95,15 @@ void refineFeatureHypotheses(const PairContext& c, SearchState& state);
 void refineStructureHypotheses(const PairContext& c, SearchState& state);
 
 /** Before a merge: each candidate the screen stopped that is a rival of
- * `best` (another placement) and scored on its sample no more than the
+ * `of` (another placement; with none, every one: a mirrored map's
+ * candidates are rivals of any) and scored on its sample no more than the
  * screen's margin below the rival floor is refined in full, in place, and
  * judged again. The screen drops a hypothesis that cannot merge; as a rival
  * between the floor and the lowest mergeable score it can still refuse a
  * wrong merge (a half map placed at scale 0.87 on a corridor's start, the
  * right placement screened at 0.35). Only pairs about to merge pay.
  * Returns how many were refined. */
-size_t refineScreenedRivals(const PairContext& c, SearchState& state, size_t best);
+size_t refineScreenedRivals(const PairContext& c, SearchState& state, const std::optional<Placement>& of);
 
 /** The best score of a candidate judged in full (not mirrored); -inf if none. */
 double bestScore(const std::vector<Aligner::TCandidate>& candidates);
