@@ -4,6 +4,7 @@
 #include <multires_map_merge/GridMapFusion.h>
 #include <multires_map_merge/JointPlacement.h>
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -41,14 +42,27 @@ double withinToleranceBounds(const FleetParams& p, double cells)
 
 double FleetParams::toleranceOf(const FleetEdge& e) const { return withinToleranceBounds(*this, byPrecision(*this, e)); }
 
-double FleetParams::cycleTolerance(const std::vector<int>& cycle, const std::vector<FleetEdge>& edges) const
+double FleetParams::cycleTolerance(
+	const std::vector<int>& cycle, const std::vector<FleetEdge>& edges, const std::vector<double>& coarse_cell) const
 {
 	// Each pair's error adds to the cycle's closure independently: they add
 	// in quadrature (a direct pair and a chain of three bent pairs disagree
 	// by about the chain's errors combined, not by one pair's).
 	double sum_sq = 0;
-	for (int c : cycle) sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]), 2);
+	for (int c : cycle)
+	{
+		const double in_closing_cells = coarse_cell.empty() ? 1.0 : coarse_cell[size_t(c)] / coarse_cell[size_t(cycle[0])];
+		sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]) * in_closing_cells, 2);
+	}
 	return withinToleranceBounds(*this, std::sqrt(sum_sq));
+}
+
+double coarseCellInReference(
+	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
+{
+	const double coarse = std::max<double>(
+		maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
+	return coarse * placements[e.to].in_reference.scale;
 }
 
 FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
@@ -80,26 +94,44 @@ double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity
 
 namespace
 {
-/** contentCorners from the map's class image (GridImage.h). */
-ContentCorners contentCorners(const GridInFrame& map, const cv::Mat& classes)
+/** wallSpread from the map's class image (GridImage.h). */
+WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes)
 {
-	std::vector<cv::Point> known;
-	cv::findNonZero(classes != kUnknown, known);
-	cv::Rect box(0, 0, int(map.grid.getSizeX()), int(map.grid.getSizeY()));
-	if (!known.empty()) box = cv::boundingRect(known);
+	// Its walls; a map with almost none: what it saw; nothing: the whole grid.
+	std::vector<cv::Point> cells_seen;
+	cv::findNonZero(classes == kOccupied, cells_seen);
+	if (cells_seen.size() < 3) cv::findNonZero(classes != kUnknown, cells_seen);
+	if (cells_seen.size() < 3) cv::findNonZero(cv::Mat::ones(classes.size(), CV_8U), cells_seen);
+	Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+	for (const auto& p : cells_seen) mean += Eigen::Vector2d(p.x, p.y);
+	mean /= double(cells_seen.size());
+	Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+	for (const auto& p : cells_seen)
+	{
+		const Eigen::Vector2d d = Eigen::Vector2d(p.x, p.y) - mean;
+		cov += d * d.transpose();
+	}
+	cov /= double(cells_seen.size());
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
 	const Similarity2D cells = map.cellToMapFrame();
-	const double x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
-	return {cells({x0, y0}), cells({x1, y0}), cells({x0, y1}), cells({x1, y1})};
+	WallSpread out;
+	for (int axis = 0; axis < 2; ++axis)
+	{
+		const Eigen::Vector2d half = std::sqrt(2 * std::max(0.0, eig.eigenvalues()[axis])) * eig.eigenvectors().col(axis);
+		out[2 * axis] = cells(mean + half);
+		out[2 * axis + 1] = cells(mean - half);
+	}
+	return out;
 }
 }  // namespace
 
-ContentCorners contentCorners(const GridInFrame& map) { return contentCorners(map, toClassImage(map.grid)); }
+WallSpread wallSpread(const GridInFrame& map) { return wallSpread(map, toClassImage(map.grid)); }
 
-double cornersRms(const ContentCorners& corners, const Similarity2D& a, const Similarity2D& b)
+double wallRms(const WallSpread& spread, const Similarity2D& a, const Similarity2D& b)
 {
 	double se = 0;
-	for (const auto& c : corners) se += (a(c) - b(c)).squaredNorm();
-	return std::sqrt(se / corners.size());
+	for (const auto& p : spread) se += (a(p) - b(p)).squaredNorm();
+	return std::sqrt(se / spread.size());
 }
 
 namespace
@@ -218,11 +250,11 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 /** How far apart two placements of `from` in `to` put what `from` saw, in
  * cells of the coarser map of the pair. */
 double disagreementCells(
-	const GridInFrame& from, const ContentCorners& from_corners, const GridInFrame& to, const Similarity2D& a,
+	const GridInFrame& from, const WallSpread& from_spread, const GridInFrame& to, const Similarity2D& a,
 	const Similarity2D& b)
 {
 	const double coarse = std::max<double>(to.grid.getResolution(), from.grid.getResolution() * a.scale);
-	return cornersRms(from_corners, a, b) / coarse;
+	return wallRms(from_spread, a, b) / coarse;
 }
 
 struct Tree
@@ -315,11 +347,19 @@ bool closesACycle(const Tree& t, const std::vector<FleetEdge>& edges, size_t k)
 		t.via_edge[e.to] != int(k);
 }
 
+/** Each edge's coarser cells in the reference's metres (0 where `to` is not placed). */
+std::vector<double> coarseCells(const std::vector<GridInFrame>& maps, const Tree& t, const std::vector<FleetEdge>& edges)
+{
+	std::vector<double> out;
+	for (const auto& e : edges) out.push_back(t.maps[e.to].placed ? coarseCellInReference(maps, t.maps, e) : 0.0);
+	return out;
+}
+
 /** Builds the tree; while a kept non-tree edge contradicts it (by more than
  * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds.
  * The tree returned holds every map's largest cycle tolerance. */
 Tree consistentTree(
-	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
+	const std::vector<GridInFrame>& maps, const std::vector<WallSpread>& spread, size_t reference,
 	std::vector<FleetEdge>& edges, const FleetParams& params)
 {
 	for (;;)
@@ -327,14 +367,15 @@ Tree consistentTree(
 		Tree t = spanningTree(maps.size(), reference, edges, params.settled_confidence);
 		std::vector<int> contradicted;
 		t.cycle_tolerance.assign(maps.size(), 0.0);
+		const std::vector<double> cells = coarseCells(maps, t, edges);
 		for (size_t k = 0; k < edges.size() && contradicted.empty(); ++k)
 		{
 			if (!closesACycle(t, edges, k)) continue;
 			const FleetEdge& e = edges[k];
 			const std::vector<int> cycle = cycleOf(t, edges, int(k));
-			const double tol = params.cycleTolerance(cycle, edges);
+			const double tol = params.cycleTolerance(cycle, edges, cells);
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
-			if (disagreementCells(maps[e.from], corners[e.from], maps[e.to], predicted, e.from_to_to) > tol)
+			if (disagreementCells(maps[e.from], spread[e.from], maps[e.to], predicted, e.from_to_to) > tol)
 				contradicted = cycle;
 			for (int c : cycle)
 				for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to})
@@ -453,24 +494,24 @@ std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
 	return out;
 }
 
-/** Each map's content corners, from its prepared class image where it has one. */
-std::vector<ContentCorners> contentCornersOf(const std::vector<GridInFrame>& maps, const PreparedMaps& prepared = {})
+/** Each map's wall spread, from its prepared class image where it has one. */
+std::vector<WallSpread> wallSpreadOf(const std::vector<GridInFrame>& maps, const PreparedMaps& prepared = {})
 {
-	std::vector<ContentCorners> out;
+	std::vector<WallSpread> out;
 	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		const bool have = m < prepared.size() && prepared[m] && !prepared[m]->classes.empty();
-		out.push_back(have ? contentCorners(maps[m], prepared[m]->classes) : contentCorners(maps[m]));
+		out.push_back(have ? wallSpread(maps[m], prepared[m]->classes) : wallSpread(maps[m]));
 	}
 	return out;
 }
 
 FleetResult placeFromPairs(
-	const std::vector<GridInFrame>& maps, const std::vector<ContentCorners>& corners, size_t reference,
+	const std::vector<GridInFrame>& maps, const std::vector<WallSpread>& spread, size_t reference,
 	std::vector<FleetEdge> edges, const FleetParams& params)
 {
 	FleetResult out;
-	const Tree tree = consistentTree(maps, corners, reference, edges, params);
+	const Tree tree = consistentTree(maps, spread, reference, edges, params);
 	out.edges = std::move(edges);
 	out.maps = tree.maps;
 	if (params.joint_refinement)
@@ -478,7 +519,7 @@ FleetResult placeFromPairs(
 		std::vector<double> tolerance;
 		for (const auto& e : out.edges) tolerance.push_back(params.toleranceOf(e));
 		const auto joint =
-			refineJointly(maps, reference, out.maps, out.edges, corners, tolerance, tree.cycle_tolerance);
+			refineJointly(maps, reference, out.maps, out.edges, spread, tolerance, tree.cycle_tolerance);
 		for (size_t m = 0; m < maps.size(); ++m)
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
@@ -511,7 +552,7 @@ FleetResult placeFromPairs(
 	for (const auto& e : edges)
 		if (e.from >= maps.size() || e.to >= maps.size() || e.from == e.to)
 			throw std::invalid_argument("a pair names a map that is not there");
-	return placeFromPairs(maps, contentCornersOf(maps), reference, std::move(edges), params);
+	return placeFromPairs(maps, wallSpreadOf(maps), reference, std::move(edges), params);
 }
 
 FleetResult placeFleet(
@@ -541,7 +582,7 @@ FleetResult placeFleet(
 	FleetResult out;
 	size_t pairs_aligned = 0, pairs_reused = 0, pairs_deferred = 0;
 	const PreparedMaps prepared = prepareAll(maps, hints.prepared, aligner, params.threads);
-	const std::vector<ContentCorners> corners = contentCornersOf(maps, prepared);
+	const std::vector<WallSpread> spread = wallSpreadOf(maps, prepared);
 	// A pair's promise, computed when first asked: an earlier merged result
 	// first (tracking it is cheap), then the most feature inliers.
 	std::map<PairKey, double> promises;
@@ -605,7 +646,7 @@ FleetResult placeFleet(
 			else if (to_align[k].stand_in) edges.push_back(*to_align[k].stand_in), ++pairs_deferred;
 			else ++pairs_deferred;
 		}
-		out = placeFromPairs(maps, corners, reference, edges, params);
+		out = placeFromPairs(maps, spread, reference, edges, params);
 		edges = out.edges;  // with the dropped marks
 		todo = nextPairs(reference, {out, done, tries_since_placed}, promise, params, params.threads);
 	}

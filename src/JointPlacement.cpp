@@ -18,29 +18,18 @@ Eigen::Matrix2d timesPoint(const Eigen::Vector2d& z)
 	m << z.x(), -z.y(), z.y(), z.x();
 	return m;
 }
-
-/** The reference's cells of the coarser map of the pair, in reference metres:
- * residuals are weighed in the cells the pair was aligned at. */
-double coarseCellInReference(
-	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
-{
-	const double coarse = std::max<double>(
-		maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
-	return coarse * placements[e.to].in_reference.scale;
-}
-
 }  // namespace
 
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
+	const std::vector<FleetEdge>& edges, const std::vector<WallSpread>& spread,
 	const std::vector<double>& tolerance_cells, const std::vector<double>& max_move_cells,
 	const JointPlacementParams& params)
 {
 	const size_t n = maps.size();
 	// One per map and one per edge: a list of another length is a caller's mix-up, said, not padded.
-	if (placements.size() != n || corners.size() != n || max_move_cells.size() != n)
-		throw std::invalid_argument("refineJointly: placements, corners and max_move_cells need one entry per map");
+	if (placements.size() != n || spread.size() != n || max_move_cells.size() != n)
+		throw std::invalid_argument("refineJointly: placements, spread and max_move_cells need one entry per map");
 	if (tolerance_cells.size() != edges.size())
 		throw std::invalid_argument("refineJointly: tolerance_cells needs one entry per edge");
 	std::vector<std::optional<Similarity2D>> out(n);
@@ -74,8 +63,8 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 				std::sqrt(weight[i]) / (coarseCellInReference(maps, placements, e) * tolerance_cells[used[i]]);
 			for (int c = 0; c < 4; ++c)
 			{
-				// T_from(p) − T_to(M(p)) = 0 for the corners p of the from map.
-				const Eigen::Vector2d p = corners[e.from][c], q = e.from_to_to(p);
+				// T_from(p) − T_to(M(p)) = 0 at the points p of the from map's wall spread.
+				const Eigen::Vector2d p = spread[e.from][c], q = e.from_to_to(p);
 				const int r = int(i) * 8 + 2 * c;
 				if (column[e.from] >= 0)
 				{
@@ -99,7 +88,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		// of its tolerance.
 		for (size_t i = 0; i < used.size(); ++i)
 		{
-			// The rows hold sqrt(weight) / (cell × tolerance) × each corner's two coordinates.
+			// The rows hold sqrt(weight) / (cell × tolerance) × each point's two coordinates.
 			const double r = (a.middleRows(int(i) * 8, 8) * x - y.segment<8>(int(i) * 8)).norm() /
 				(2 * std::sqrt(weight[i]));
 			weight[i] = r <= params.robust_share ? 1.0 : params.robust_share / r;
@@ -114,7 +103,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		const Similarity2D& tree = placements[m].in_reference;
 		const double cell = std::max<double>(
 			maps[reference].grid.getResolution(), maps[m].grid.getResolution() * tree.scale);
-		if (cornersRms(corners[m], joint, tree) / cell <= max_move[m]) out[m] = joint;
+		if (wallRms(spread[m], joint, tree) / cell <= max_move[m]) out[m] = joint;
 	}
 	return out;
 }

@@ -449,11 +449,33 @@ TEST(FleetGraph, JointRefinementPlacesAChainedMapByEveryPairThatSeesIt)
 	EXPECT_EQ(joint.maps[3].parent, 2);
 	EXPECT_DOUBLE_EQ(joint.maps[3].confidence, 0.99);
 	// A list of the wrong length is said, not padded with zeros.
-	const std::vector<ContentCorners> corners(4, contentCorners(maps[0]));
+	const std::vector<WallSpread> spread(4, wallSpread(maps[0]));
 	const std::vector<double> per_edge(edges.size(), 3.0), per_map(4, 3.0);
-	EXPECT_NO_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_edge, per_map));
-	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_edge, {3.0}), std::invalid_argument);
-	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, corners, per_map, per_map), std::invalid_argument);
+	EXPECT_NO_THROW(refineJointly(maps, 0, tree.maps, edges, spread, per_edge, per_map));
+	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, spread, per_edge, {3.0}), std::invalid_argument);
+	EXPECT_THROW(refineJointly(maps, 0, tree.maps, edges, spread, per_map, per_map), std::invalid_argument);
+}
+
+TEST(Fleet, APlacementsWallDisplacementIsItsRmsOverEveryWallCell)
+{
+	// What the cycle check and the joint refinement measure (wallRms at the
+	// four points of a WallSpread) is how far two placements move the map's
+	// walls, RMS over every wall cell: checked against the cells one by one.
+	const Fleet* f = fleet();
+	if (!f) GTEST_SKIP() << "needs " << MMM_SHARED_DATA << "/carmen_corrected";
+	const GridInFrame& map = f->maps[1];
+	const cv::Mat classes = toClassImage(map.grid);
+	std::vector<cv::Point> walls;
+	cv::findNonZero(classes == kOccupied, walls);
+	ASSERT_GT(walls.size(), 100u);
+	const Similarity2D cells = map.cellToMapFrame(), a = f->robots[1].truth,
+					   b = Similarity2D(1.03, 0.05, {0.4, -0.3}).compose(a);
+	double se = 0;
+	for (const auto& w : walls) se += (a(cells({double(w.x), double(w.y)})) - b(cells({double(w.x), double(w.y)}))).squaredNorm();
+	const double every_cell = std::sqrt(se / double(walls.size()));
+	EXPECT_NEAR(wallRms(wallSpread(map), a, b), every_cell, 1e-6 * every_cell);
+	// The grid's corners count a turn farther from the walls than they are.
+	EXPECT_GT(cornerRms(map, a, b), 1.2 * every_cell);
 }
 
 TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)
@@ -491,8 +513,9 @@ TEST(FleetGraph, TheCycleToleranceFollowsThePairsPrecision)
 
 	const FleetResult bent = placed(3.0);
 	EXPECT_FALSE(bent.edges[2].dropped);
-	const double off_path = cornerRms(maps[2], bent.maps[2].in_reference, truth[2]) / 0.1,
-				 off_direct = cornerRms(maps[2], bent.maps[2].in_reference, truth[0].compose(direct)) / 0.1;
+	const WallSpread spread = wallSpread(maps[2]);
+	const double off_path = wallRms(spread, bent.maps[2].in_reference, truth[2]) / 0.1,
+				 off_direct = wallRms(spread, bent.maps[2].in_reference, truth[0].compose(direct)) / 0.1;
 	EXPECT_GT(off_path, 1.0);
 	EXPECT_GT(off_direct, 1.0);
 	EXPECT_NEAR(off_path + off_direct, 8.0, 0.5);
@@ -528,8 +551,9 @@ TEST(FleetGraph, AChainsErrorsAddUpAroundACycle)
 	const std::vector<GridInFrame> maps = blankMaps(4);
 	Similarity2D direct = between(3, 0);
 	direct.t += Eigen::Vector2d(1.2, 0);
-	const double off_chain = cornerRms(maps[3], bent.maps[3].in_reference, truth[3]) / 0.1,
-				 off_direct = cornerRms(maps[3], bent.maps[3].in_reference, direct) / 0.1;
+	const WallSpread spread = wallSpread(maps[3]);
+	const double off_chain = wallRms(spread, bent.maps[3].in_reference, truth[3]) / 0.1,
+				 off_direct = wallRms(spread, bent.maps[3].in_reference, direct) / 0.1;
 	EXPECT_GT(off_chain, 2.0);
 	EXPECT_GT(off_direct, 1.0);
 	EXPECT_NEAR(off_chain + off_direct, 12.0, 0.5);
@@ -539,6 +563,12 @@ TEST(FleetGraph, AChainsErrorsAddUpAroundACycle)
 	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, precise_edges), defaults.cycle_tolerance_cells);
 	EXPECT_TRUE(precise.edges[3].dropped);
 	expectNear(precise.maps[3].in_reference, truth[3]);
+
+	// Pairs of maps with cells of other sizes: each RMSE counts in its own
+	// pair's coarser cells, the cycle's tolerance in the closing pair's (two
+	// pairs of 2× cells at RMSE 2 allow 16 of its 1× cells each, not 8).
+	const std::vector<double> coarse_cell = {2, 2, 1, 1};
+	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, bent_edges, coarse_cell), std::sqrt(2 * 8.0 * 8 + 2 * 16.0 * 16));
 
 	// At most what the decision tells apart as rival placements.
 	std::vector<FleetEdge> loose = bent_edges;

@@ -82,8 +82,8 @@ struct FleetParams
 	 * every pair the data allows checked by a cycle pays that. Each
 	 * placement says whether it was (FleetPlacement::checked_by_cycle). */
 	unsigned second_path_tries = 0;
-	/** A cycle whose composed transform moves the corners of what a map saw
-	 * by more than its tolerance (cells of the coarser map, RMS) is
+	/** A cycle whose composed transform moves the walls of a map (RMS,
+	 * wallRms) by more than its tolerance (cells of the coarser map) is
 	 * contradictory. A pair's tolerance follows its precision:
 	 * `cycle_tolerance_per_rmse` × its edge RMSE, at least
 	 * `cycle_tolerance_cells` and at most `cycle_tolerance_max_cells`; a
@@ -101,8 +101,14 @@ struct FleetParams
 	double cycle_tolerance_max_cells = 0;
 	/** The tolerance of one pair (see cycle_tolerance_cells). */
 	double toleranceOf(const FleetEdge& e) const;
-	/** The tolerance of a cycle of `edges` (indices; see cycle_tolerance_cells). */
-	double cycleTolerance(const std::vector<int>& cycle, const std::vector<FleetEdge>& edges) const;
+	/** The tolerance of a cycle of `edges` (indices, the closing edge first;
+	 * see cycle_tolerance_cells), in cells of the closing edge. Each pair's
+	 * RMSE is in its own coarser cells: `coarse_cell` (one per edge, one
+	 * length unit: coarseCellInReference) puts them in one unit; empty: all
+	 * pairs' cells are taken as one size. */
+	double cycleTolerance(
+		const std::vector<int>& cycle, const std::vector<FleetEdge>& edges,
+		const std::vector<double>& coarse_cell = {}) const;
 	/** The largest tolerance: cycle_tolerance_max_cells, or its default. */
 	double maxToleranceCells() const;
 	/** These parameters with cycle_tolerance_max_cells 0 set to the
@@ -185,18 +191,28 @@ struct FleetResult
 	bool allPlaced() const;
 };
 
+/** The cells of the coarser map of the pair `e` in the reference's metres,
+ * `e.to` placed by `placements`: what the pair's RMSE and tolerance count. */
+double coarseCellInReference(
+	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e);
+
 /** RMS distance (metres of the target frame) between where two transforms
  * put the four corners of `map`'s grid: how far apart two placements of a
  * map are. */
 double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
 
-/** The corners of the box around what a map saw (its known cells), in its
- * frame: where its placement matters (a grid's padding of unknown space
- * would count a small turn many cells away from anything seen). */
-using ContentCorners = std::array<Eigen::Vector2d, 4>;
-ContentCorners contentCorners(const GridInFrame& map);
-/** RMS distance between where two transforms put the corners. */
-double cornersRms(const ContentCorners& corners, const Similarity2D& a, const Similarity2D& b);
+/** Four points of a map's frame with the mean and the spread (covariance)
+ * of its wall cells (occupied; its known cells if it has almost none): the
+ * centroid ± √(2λ) along each principal axis. A similarity moves every
+ * point affinely, so the RMS of two placements' difference at these four is
+ * exactly its RMS over every wall cell: how far apart two placements put
+ * what the map saw, as the benchmark measures a placement (the corners of
+ * the box around it would count a turn about √3 times over, and a grid's
+ * padding of unknown space more). */
+using WallSpread = std::array<Eigen::Vector2d, 4>;
+WallSpread wallSpread(const GridInFrame& map);
+/** RMS distance between where two transforms put a map's walls (its WallSpread). */
+double wallRms(const WallSpread& spread, const Similarity2D& a, const Similarity2D& b);
 
 /** The placement from pairs already aligned (placeFleet's step after each
  * round of alignments): the maximum spanning tree from the reference, cycles

@@ -17,7 +17,7 @@ struct JointPlacementParams
 {
 	/** Iteratively reweighted least squares: a pair that disagrees with the
 	 * joint placement by more than this share of its tolerance (RMS over the
-	 * corners of the `from` map's content) counts less (Huber), so one bad
+	 * `from` map's walls, wallRms) counts less (Huber), so one bad
 	 * pair cannot pull the others. */
 	double robust_share = 1.0 / 3;
 	int reweighting_rounds = 5;
@@ -25,11 +25,11 @@ struct JointPlacementParams
 
 /** Every placed map's pose in the reference's frame (`in_reference` of each
  * placed map; the reference fixed) refined from every confident pair that is
- * not dropped and joins two placed maps, each weighed at the corners of its
- * `from` map's content (`corners`, one per map) in units of its tolerance
+ * not dropped and joins two placed maps, each weighed at its `from` map's
+ * walls (`spread`, one WallSpread per map) in units of its tolerance
  * (`tolerance_cells`, one per edge, cells of its coarser map: FleetParams::
  * toleranceOf), so a precise pair counts more than one of bent maps. A map
- * whose refined pose moves its content from its tree placement by more than
+ * whose refined pose moves its walls from its tree placement by more than
  * its `max_move_cells` (one per map; the cycle check admits pairs that far
  * apart around the cycles it lies on), or than the largest tolerance of its
  * pairs, keeps the tree's: a larger move means the pairs do not support one
@@ -38,7 +38,7 @@ struct JointPlacementParams
  * not one entry per map or edge. */
 std::vector<std::optional<Similarity2D>> refineJointly(
 	const std::vector<GridInFrame>& maps, size_t reference, const std::vector<FleetPlacement>& placements,
-	const std::vector<FleetEdge>& edges, const std::vector<ContentCorners>& corners,
+	const std::vector<FleetEdge>& edges, const std::vector<WallSpread>& spread,
 	const std::vector<double>& tolerance_cells, const std::vector<double>& max_move_cells,
 	const JointPlacementParams& params = {});
 
