@@ -160,8 +160,7 @@ void runPartialCalibrationPairs(const BenchContext& ctx, const HalmstadData& dat
 	const std::string dir = ctx.tempDir("partial");
 	const auto sink = [&ctx](const PartialRun& run, const GridInFrame& ref, const GridInFrame& half,
 						  const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of) {
-		const std::string other = run.other + (run.half == kPartialHalves.front() ? "_half1" : "_half2");
-		writeFinishedCandidates(ctx, {run.site, run.ref, other, run.positive}, ref, half, r, error_of);
+		writeFinishedCandidates(ctx, {run.site, run.ref, halfName(run.other, run.half_index), run.positive}, ref, half, r, error_of);
 	};
 	runPartialMaps(data, {"E5", "HIH"}, ctx.options, dir, sink);
 	fs::remove_all(dir);

@@ -68,6 +68,8 @@ double shareOnKnown(const std::vector<Eigen::Vector2d>& px, const Similarity2D& 
 
 }  // namespace
 
+std::string halfName(const std::string& map, size_t k) { return map + "_half" + std::to_string(k + 1); }
+
 MapHalf writeHalf(const HalmstadData& data, const std::string& map, size_t k, const std::string& dir)
 {
 	const cv::Mat img = readGrey(data.png(map));
@@ -76,7 +78,7 @@ MapHalf writeHalf(const HalmstadData& data, const std::string& map, size_t k, co
 	out.occupied = occupiedIn(img, half);
 	out.whole_rows = img.rows;
 	fs::create_directories(dir);
-	const std::string name = map + "_half" + std::to_string(k + 1);
+	const std::string name = halfName(map, k);
 	const std::string pgm = dir + "/" + name + ".pgm";
 	out.yaml = dir + "/" + name + ".yaml";
 	if (!cv::imwrite(pgm, img(half).clone())) throw std::runtime_error("'" + pgm + "': cannot write");
@@ -135,7 +137,8 @@ std::vector<PartialRun> runPartialMaps(
 			{
 				const MapHalf& half = halvesOf(p.src)[k];
 				PartialRun run;
-				run.site = site, run.ref = p.dst, run.other = p.src, run.half = kPartialHalves[k], run.positive = true;
+				run.site = site, run.ref = p.dst, run.other = p.src, run.half = kPartialHalves[k], run.half_index = k;
+				run.positive = true;
 				run.inside_ref = shareOnKnown(half.occupied, p.src_to_dst_px, image(p.dst));
 				const PartialRun done = align(run, data.yaml(p.dst, dir), half, p.src_to_dst_px, image(p.dst).rows);
 				std::cout << "partial " << done.ref << " <- " << done.other << " " << done.half << " (inside REF "
@@ -152,7 +155,7 @@ std::vector<PartialRun> runPartialMaps(
 				for (size_t k = 0; k < kPartialHalves.size(); ++k)
 				{
 					PartialRun run;
-					run.site = site, run.ref = ref, run.other = map, run.half = kPartialHalves[k];
+					run.site = site, run.ref = ref, run.other = map, run.half = kPartialHalves[k], run.half_index = k;
 					const PartialRun done = align(run, data.yaml(ref, dir), halvesOf(map)[k], std::nullopt, 0);
 					if (done.merged)
 						std::cout << "partial " << ref << " <- " << map << " " << done.half << ": MERGED (false)" << std::endl;

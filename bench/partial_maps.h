@@ -32,14 +32,18 @@ struct MapHalf
 	int whole_rows = 0;  //!< of the whole map's image
 };
 
+/** The name of half `k` (0, 1) of `map`: MAP_half1, MAP_half2. */
+std::string halfName(const std::string& map, size_t k);
+
 /** Half `k` (0, 1) of `map`'s known extent, cut across its longer side, as a
- * map_server file `MAP_halfK.yaml` in `dir` of its own size, its origin where
- * the half lies in the whole map's frame (origin 0). */
+ * map_server file `halfName(map, k).yaml` in `dir` of its own size, its
+ * origin where the half lies in the whole map's frame (origin 0). */
 MapHalf writeHalf(const HalmstadData& data, const std::string& map, size_t k, const std::string& dir);
 
 struct PartialRun
 {
 	std::string site, ref, other, half;
+	size_t half_index = 0;  //!< which of kPartialHalves `half` is (halfName)
 	bool positive = false;  //!< same site: the annotation says where the half lies
 	bool merged = false;
 	bool right = false;  //!< merged with the half's occupied pixels ≤ kRightPx from the annotation (mean)
