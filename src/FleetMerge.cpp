@@ -627,6 +627,12 @@ FleetResult placeFleet(
 				if (p.stand_in->merged && known->track) p.start = p.stand_in->from_to_to;
 				p.age = known->age;
 			}
+			// Both maps placed (a second or surer path): the pair is refined
+			// from where the fleet puts them first, one refinement when that
+			// is confident on the pair's own walls; the global search only
+			// when it is not.
+			if (!p.start && placed_before[to] && placed_before[from])
+				p.start = out.maps[to].in_reference.inverse().compose(out.maps[from].in_reference);
 			to_align.push_back(p);
 		}
 		const size_t overdue = hints.overdue_age;

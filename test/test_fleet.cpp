@@ -157,14 +157,16 @@ bool hangsOnOnePair(const FleetResult& r, size_t m)
 	return false;
 }
 
-// With second_path_tries, a robot placed by one pair looks for a second
-// path, so a cycle checks that pair; off (the default), the two robots
+// With second_path_tries (1, the default), a robot placed by one pair looks
+// for a second path, so a cycle checks that pair; at 0, the two robots
 // placed directly on the reference hang on their one pair each.
 TEST(Fleet, ARobotHangingOnOnePairLooksForASecondPathWhenAsked)
 {
 	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
 	const Fleet& f = *fleet();
-	const FleetResult once = placeFleet(f.maps, 0, CScalingGridMapAligner());
+	FleetParams one_path;
+	one_path.second_path_tries = 0;
+	const FleetResult once = placeFleet(f.maps, 0, CScalingGridMapAligner(), one_path);
 	FleetParams two_paths;
 	two_paths.second_path_tries = 1;
 	const FleetResult checked = placeFleet(f.maps, 0, CScalingGridMapAligner(), two_paths);

@@ -75,13 +75,13 @@ struct FleetParams
 	/** A placed map whose placement hangs on one pair (no second path of
 	 * confident pairs to the reference: nothing checks that pair around a
 	 * cycle or refines it jointly) tries this many more pairs, most
-	 * promising first, for a second path. Off by default: on the Halmstad
-	 * fleets it aligns a third more pairs and moves no placement closer to
-	 * the annotation, and on renderings of one log (the fleet test) the
-	 * extra pairs pull a chained map half a cell farther; a user who wants
-	 * every pair the data allows checked by a cycle pays that. Each
-	 * placement says whether it was (FleetPlacement::checked_by_cycle). */
-	unsigned second_path_tries = 0;
+	 * promising first, for a second path. A pair of two placed maps is
+	 * refined from where the fleet puts them first (placeFleet), so a
+	 * second path costs about one refinement and measures the two maps'
+	 * own overlap for the joint refinement. 0: a map placed by one pair
+	 * keeps it alone (fewer pairs aligned). Each placement says whether a
+	 * cycle checked it (FleetPlacement::checked_by_cycle). */
+	unsigned second_path_tries = 1;
 	/** A cycle whose composed transform moves the walls of a map (RMS,
 	 * wallRms) by more than its tolerance (cells of the coarser map) is
 	 * contradictory. A pair's tolerance follows its precision:
