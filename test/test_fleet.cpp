@@ -184,6 +184,11 @@ TEST(Fleet, ARobotHangingOnOnePairLooksForASecondPathWhenAsked)
 		for (size_t m = 1; m < r->maps.size(); ++m)
 			EXPECT_EQ(r->maps[m].checked_by_cycle, r->maps[m].placed && !hangsOnOnePair(*r, m)) << f.robots[m].file;
 	EXPECT_GT(checked.pairs_aligned, once.pairs_aligned);
+	// The second path between two placed robots was refined from where the
+	// fleet put them (tracked), and found confident there.
+	EXPECT_TRUE(std::any_of(checked.edges.begin(), checked.edges.end(), [&](const FleetEdge& e) {
+		return e.tracked && e.merged && !e.dropped && e.from != 0 && e.to != 0;
+	}));
 	EXPECT_FALSE(checked.maps.back().placed);  // the other building still out
 }
 
