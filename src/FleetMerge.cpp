@@ -630,8 +630,9 @@ FleetResult placeFleet(
 			// Both maps placed (a second or surer path): the pair is refined
 			// from where the fleet puts them first, one refinement when that
 			// is confident on the pair's own walls; the global search only
-			// when it is not.
-			if (!p.start && placed_before[to] && placed_before[from])
+			// when it is not, or when the caller wants it searched afresh
+			// (an independent check: FleetHints::Known::track).
+			if (!p.start && (!known || known->track) && placed_before[to] && placed_before[from])
 				p.start = out.maps[to].in_reference.inverse().compose(out.maps[from].in_reference);
 			to_align.push_back(p);
 		}
