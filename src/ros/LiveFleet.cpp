@@ -226,7 +226,8 @@ FleetHints LiveFleet::hintsFor(const Snapshot& s, std::chrono::steady_clock::tim
 		// Tracking follows the last result; a fresh search now and then, and
 		// whenever a move awaits confirmation, keeps a wrong placement from
 		// confirming itself.
-		k.track = !s.pending[to] && !s.pending[from] && s.estimation < mem.searched + params_.retry_estimations;
+		k.track = !s.pending[to] && !s.pending[from] && mem.searched &&
+			s.estimation < *mem.searched + params_.retry_estimations;
 		return k;
 	};
 	hints.overdue_age = params_.retry_estimations;
@@ -255,7 +256,10 @@ void LiveFleet::remember(const Snapshot& s, const FleetResult& result)
 		mem.to_known = s.known_cells[e.to], mem.from_known = s.known_cells[e.from];
 		mem.estimation = s.estimation;
 		const auto before = pair_memory_.find(key);
-		mem.searched = e.tracked && before != pair_memory_.end() ? before->second.searched : s.estimation;
+		// Tracked (from its earlier result, or from where the fleet put its
+		// maps) is not searched afresh: it keeps when it last was, if ever.
+		if (!e.tracked) mem.searched = s.estimation;
+		else if (before != pair_memory_.end()) mem.searched = before->second.searched;
 		pair_memory_[key] = mem;
 	}
 }

@@ -141,7 +141,9 @@ class LiveFleet
 		size_t to_version = 0, from_version = 0;
 		size_t to_known = 0, from_known = 0;  //!< known cells of each map then
 		size_t estimation = 0;  //!< when
-		size_t searched = 0;  //!< when last searched afresh (not tracked)
+		/** When last searched afresh (not tracked); none: never (a pair
+		 * tracked from where the fleet put its maps). */
+		std::optional<size_t> searched;
 	};
 	struct PreparedMemory
 	{
