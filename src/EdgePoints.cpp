@@ -5,8 +5,6 @@
 
 namespace multires_map_merge
 {
-namespace
-{
 PointList cellsOf(const cv::Mat& mask)
 {
 	std::vector<cv::Point> cells;
@@ -16,7 +14,6 @@ PointList cellsOf(const cv::Mat& mask)
 	for (const auto& c : cells) pts.emplace_back(c.x, c.y);
 	return pts;
 }
-}  // namespace
 
 PointList edgePoints(const cv::Mat& classes)
 {

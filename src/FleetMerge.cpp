@@ -1,4 +1,5 @@
 #include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/FeatureHypotheses.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GridMapFusion.h>
@@ -94,34 +95,48 @@ double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity
 
 namespace
 {
-/** wallSpread from the map's class image (GridImage.h). */
-WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes)
+/** Four points with the mean and the spread of `cells` (cell coordinates,
+ * at least one), in the map's frame (`to_frame`): see WallSpread. */
+WallSpread spreadOf(const PointList& cells, const Similarity2D& to_frame)
 {
-	// Its walls; a map with almost none: what it saw; nothing: the whole grid.
-	std::vector<cv::Point> cells_seen;
-	cv::findNonZero(classes == kOccupied, cells_seen);
-	if (cells_seen.size() < 3) cv::findNonZero(classes != kUnknown, cells_seen);
-	if (cells_seen.size() < 3) cv::findNonZero(cv::Mat::ones(classes.size(), CV_8U), cells_seen);
 	Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-	for (const auto& p : cells_seen) mean += Eigen::Vector2d(p.x, p.y);
-	mean /= double(cells_seen.size());
+	for (const auto& p : cells) mean += p;
+	mean /= double(cells.size());
 	Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-	for (const auto& p : cells_seen)
-	{
-		const Eigen::Vector2d d = Eigen::Vector2d(p.x, p.y) - mean;
-		cov += d * d.transpose();
-	}
-	cov /= double(cells_seen.size());
+	for (const auto& p : cells) cov += (p - mean) * (p - mean).transpose();
+	cov /= double(cells.size());
 	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-	const Similarity2D cells = map.cellToMapFrame();
 	WallSpread out;
 	for (int axis = 0; axis < 2; ++axis)
 	{
 		const Eigen::Vector2d half = std::sqrt(2 * std::max(0.0, eig.eigenvalues()[axis])) * eig.eigenvectors().col(axis);
-		out[2 * axis] = cells(mean + half);
-		out[2 * axis + 1] = cells(mean - half);
+		out[2 * axis] = to_frame(mean + half);
+		out[2 * axis + 1] = to_frame(mean - half);
 	}
 	return out;
+}
+
+/** wallSpread from the map's class image (GridImage.h). */
+WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes)
+{
+	// Its walls; a map with almost none: what it saw; nothing: the whole grid.
+	PointList cells_seen = occupiedPoints(classes);
+	if (cells_seen.size() < 3) cells_seen = cellsOf(classes != kUnknown);
+	if (cells_seen.size() < 3) cells_seen = cellsOf(cv::Mat::ones(classes.size(), CV_8U));
+	return spreadOf(cells_seen, map.cellToMapFrame());
+}
+
+/** The WallSpread of `from`'s walls that `cells` (from's cells → to's)
+ * puts on space `to` saw (FleetEdge::overlap); none with fewer than three. */
+std::optional<WallSpread> overlapSpread(
+	const GridInFrame& from, const PreparedMap& from_prepared, const PreparedMap& to_prepared,
+	const Similarity2D& cells)
+{
+	PointList shared;
+	for (const auto& p : occupiedPoints(from_prepared.classes))
+		if (onMask(to_prepared.field.known, cells(p))) shared.push_back(p);
+	if (shared.size() < 3) return std::nullopt;
+	return spreadOf(shared, from.cellToMapFrame());
 }
 }  // namespace
 
@@ -190,7 +205,12 @@ PreparedMaps prepareAll(
 /** The edge as `from` placed in `to` (an edge holds one direction). */
 FleetEdge orientedAs(FleetEdge e, size_t to, size_t from)
 {
-	if (e.to == from && e.from == to) std::swap(e.to, e.from), e.from_to_to = e.from_to_to.inverse();
+	if (e.to != from || e.from != to) return e;
+	// The overlap seen from the other map: a similarity moves the spread's
+	// points as it moves every wall cell.
+	if (e.overlap)
+		for (auto& p : *e.overlap) p = e.from_to_to(p);
+	std::swap(e.to, e.from), e.from_to_to = e.from_to_to.inverse();
 	return e;
 }
 
@@ -238,6 +258,7 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 			e.confidence = r.success ? r.confidence : 0.0;
 			e.rmse_coarse_cells = r.trimmed_rmse_coarse_cells;
 			e.message = r.message;
+			if (r.success) e.overlap = overlapSpread(maps[e.from], other, ref, r.cells);
 		}
 		catch (const std::exception& ex)
 		{

@@ -63,8 +63,9 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 				std::sqrt(weight[i]) / (coarseCellInReference(maps, placements, e) * tolerance_cells[used[i]]);
 			for (int c = 0; c < 4; ++c)
 			{
-				// T_from(p) − T_to(M(p)) = 0 at the points p of the from map's wall spread.
-				const Eigen::Vector2d p = spread[e.from][c], q = e.from_to_to(p);
+				// T_from(p) − T_to(M(p)) = 0 at the points p of the pair's
+				// overlap (where it measured), else of the from map's walls.
+				const Eigen::Vector2d p = (e.overlap ? *e.overlap : spread[e.from])[c], q = e.from_to_to(p);
 				const int r = int(i) * 8 + 2 * c;
 				if (column[e.from] >= 0)
 				{

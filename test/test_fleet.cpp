@@ -582,3 +582,33 @@ TEST(FleetGraph, AChainsErrorsAddUpAroundACycle)
 	for (auto& e : loose) e.rmse_coarse_cells = 30;
 	EXPECT_DOUBLE_EQ(defaults.cycleTolerance({3, 0, 1, 2}, loose), defaults.maxToleranceCells());
 }
+
+TEST(FleetGraph, APairCountsWhereItsMapsOverlap)
+{
+	// Map 2 through map 1 (exact pairs), and a direct pair 0 <- 2 right where
+	// the two maps overlap (a corner of map 2, around (1, 1) m of its frame)
+	// but turned 1° about it: two bent maps fit at their overlap, and their
+	// pair says little about the turn farther off. Measured at its overlap, it
+	// agrees with the path and leaves map 2 where the path puts it; measured
+	// over the whole map, it would pull map 2 turned.
+	const std::vector<Similarity2D> truth = {{}, Similarity2D(1, 0.3, {2, 1}), Similarity2D(1, -0.5, {-3, 4})};
+	auto between = [&](size_t from, size_t to) { return truth[to].inverse().compose(truth[from]); };
+	const Eigen::Vector2d corner(1, 1);  // map 2's frame
+	const Similarity2D about_corner =
+		Similarity2D(1, 0, corner).compose(Similarity2D(1, M_PI / 180, {0, 0})).compose(Similarity2D(1, 0, -corner));
+	const Similarity2D direct = between(2, 0).compose(about_corner);
+	std::vector<FleetEdge> edges = {edge(1, 0, between(1, 0), 0.99), edge(2, 1, between(2, 1), 0.99), edge(2, 0, direct, 0.7)};
+	for (auto& e : edges) e.rmse_coarse_cells = 3.0;  // bent maps: the pairs' disagreement is within their tolerance
+	const std::vector<GridInFrame> maps = blankMaps(3);
+	const WallSpread whole = wallSpread(maps[2]);
+	const FleetResult over_the_map = placeFromPairs(maps, 0, edges);
+	edges[2].overlap = WallSpread{corner + Eigen::Vector2d(0.5, 0), corner - Eigen::Vector2d(0.5, 0),
+								  corner + Eigen::Vector2d(0, 0.5), corner - Eigen::Vector2d(0, 0.5)};
+	const FleetResult at_overlap = placeFromPairs(maps, 0, edges);
+	ASSERT_FALSE(at_overlap.edges[2].dropped);
+	ASSERT_NE(at_overlap.maps[2].message.find("refined jointly"), std::string::npos) << at_overlap.maps[2].message;
+	const double turned_cells = wallRms(whole, over_the_map.maps[2].in_reference, truth[2]) / 0.1,
+				 at_overlap_cells = wallRms(whole, at_overlap.maps[2].in_reference, truth[2]) / 0.1;
+	EXPECT_GT(turned_cells, 0.5);  // the whole-map pull: about half the turn's 1.3 cells at the walls
+	EXPECT_LT(at_overlap_cells, 0.4 * turned_cells);
+}

@@ -19,4 +19,7 @@ PointList edgePoints(const cv::Mat& classes);
  * finishes on these (TConfigParams::icp_finish_on_occupied). */
 PointList occupiedPoints(const cv::Mat& classes);
 
+/** The set cells of a CV_8U mask, same coordinates. */
+PointList cellsOf(const cv::Mat& mask);
+
 }  // namespace multires_map_merge

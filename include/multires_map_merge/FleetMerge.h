@@ -27,6 +27,16 @@ class CConfigFileBase;
 
 namespace multires_map_merge
 {
+/** Four points of a map's frame with the mean and the spread (covariance)
+ * of its wall cells (occupied; its known cells if it has almost none): the
+ * centroid ± √(2λ) along each principal axis. A similarity moves every
+ * point affinely, so the RMS of two placements' difference at these four is
+ * exactly its RMS over every wall cell: how far apart two placements put
+ * what the map saw, as the benchmark measures a placement (the corners of
+ * the box around it would count a turn about √3 times over, and a grid's
+ * padding of unknown space more). */
+using WallSpread = std::array<Eigen::Vector2d, 4>;
+
 /** One aligned pair: `from`'s frame placed in `to`'s (between map frames). */
 struct FleetEdge
 {
@@ -39,6 +49,12 @@ struct FleetEdge
 	 * cell; two SLAM runs of one building bend apart and fit at 1–10. */
 	double rmse_coarse_cells = 0;
 	std::string message;  //!< the aligner's
+	/** The spread (WallSpread, `from`'s frame) of `from`'s walls that the
+	 * pair puts on space `to` saw: where the pair measured. A pair fits two
+	 * bent maps at their overlap; away from it, it says little (a small
+	 * overlap, little about the turn), so the joint refinement weighs it
+	 * there. None: not aligned here (the whole map's walls stand in). */
+	std::optional<WallSpread> overlap;
 	bool dropped = false;  //!< contradicted the others around a cycle
 	bool reused = false;  //!< an earlier result (FleetHints::known), not aligned in this call
 	bool tracked = false;  //!< refined from the earlier transform only (no global search)
@@ -201,15 +217,7 @@ double coarseCellInReference(
  * map are. */
 double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
 
-/** Four points of a map's frame with the mean and the spread (covariance)
- * of its wall cells (occupied; its known cells if it has almost none): the
- * centroid ± √(2λ) along each principal axis. A similarity moves every
- * point affinely, so the RMS of two placements' difference at these four is
- * exactly its RMS over every wall cell: how far apart two placements put
- * what the map saw, as the benchmark measures a placement (the corners of
- * the box around it would count a turn about √3 times over, and a grid's
- * padding of unknown space more). */
-using WallSpread = std::array<Eigen::Vector2d, 4>;
+/** The WallSpread of a map (see WallSpread). */
 WallSpread wallSpread(const GridInFrame& map);
 /** RMS distance between where two transforms put a map's walls (its WallSpread). */
 double wallRms(const WallSpread& spread, const Similarity2D& a, const Similarity2D& b);

@@ -17,7 +17,7 @@ struct JointPlacementParams
 {
 	/** Iteratively reweighted least squares: a pair that disagrees with the
 	 * joint placement by more than this share of its tolerance (RMS over the
-	 * `from` map's walls, wallRms) counts less (Huber), so one bad
+	 * walls it is weighed at, wallRms) counts less (Huber), so one bad
 	 * pair cannot pull the others. */
 	double robust_share = 1.0 / 3;
 	int reweighting_rounds = 5;
@@ -25,8 +25,9 @@ struct JointPlacementParams
 
 /** Every placed map's pose in the reference's frame (`in_reference` of each
  * placed map; the reference fixed) refined from every confident pair that is
- * not dropped and joins two placed maps, each weighed at its `from` map's
- * walls (`spread`, one WallSpread per map) in units of its tolerance
+ * not dropped and joins two placed maps, each weighed where it measured
+ * (FleetEdge::overlap; without one, at its `from` map's walls: `spread`,
+ * one WallSpread per map) in units of its tolerance
  * (`tolerance_cells`, one per edge, cells of its coarser map: FleetParams::
  * toleranceOf), so a precise pair counts more than one of bent maps. A map
  * whose refined pose moves its walls from its tree placement by more than
