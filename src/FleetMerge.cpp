@@ -58,12 +58,19 @@ double FleetParams::cycleTolerance(
 	return withinToleranceBounds(*this, std::sqrt(sum_sq));
 }
 
+namespace
+{
+/** The cells of the coarser map of the pair `e`, in `e.to`'s metres. */
+double coarseCellInTo(const std::vector<GridInFrame>& maps, const FleetEdge& e)
+{
+	return std::max<double>(maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
+}
+}  // namespace
+
 double coarseCellInReference(
 	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
 {
-	const double coarse = std::max<double>(
-		maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
-	return coarse * placements[e.to].in_reference.scale;
+	return coarseCellInTo(maps, e) * placements[e.to].in_reference.scale;
 }
 
 FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
@@ -268,14 +275,13 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 	return out;
 }
 
-/** How far apart two placements of `from` in `to` put what `from` saw, in
- * cells of the coarser map of the pair. */
+/** How far `predicted` (from → to) puts what `from` saw from where the pair
+ * `e` puts it, in cells of the coarser map of the pair. */
 double disagreementCells(
-	const GridInFrame& from, const WallSpread& from_spread, const GridInFrame& to, const Similarity2D& a,
-	const Similarity2D& b)
+	const std::vector<GridInFrame>& maps, const WallSpread& from_spread, const FleetEdge& e,
+	const Similarity2D& predicted)
 {
-	const double coarse = std::max<double>(to.grid.getResolution(), from.grid.getResolution() * a.scale);
-	return wallRms(from_spread, a, b) / coarse;
+	return wallRms(from_spread, predicted, e.from_to_to) / coarseCellInTo(maps, e);
 }
 
 struct Tree
@@ -396,7 +402,7 @@ Tree consistentTree(
 			const std::vector<int> cycle = cycleOf(t, edges, int(k));
 			const double tol = params.cycleTolerance(cycle, edges, cells);
 			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
-			if (disagreementCells(maps[e.from], spread[e.from], maps[e.to], predicted, e.from_to_to) > tol)
+			if (disagreementCells(maps, spread[e.from], e, predicted) > tol)
 				contradicted = cycle;
 			for (int c : cycle)
 				for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to})
