@@ -308,9 +308,12 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
 
 double CScalingGridMapAligner::mirrorPass(const TPreparedMap& ref, const TPreparedMap& other, SearchState& search) const
 {
-	const PreparedMapPtr flipped = mirroredMap(other);
+	// The reference mirrored, not the other map: the same check (a
+	// reflection of both is no change), and kept with the prepared
+	// reference, which a fleet aligns every map of its first round to.
+	const PreparedMapPtr flipped = ref.mirrored();
 	std::map<std::string, double> not_reported;  // its stages are timed as "mirror"
-	const PairContext ctx = pair_search::makeContext(ref, *flipped, options, *this, not_reported);
+	const PairContext ctx = pair_search::makeContext(*flipped, other, options, *this, not_reported);
 	SearchState mirror;
 	// Below the best score so far, a mirrored candidate cannot lower the confidence.
 	const double lowest = options.decision.lowestMergeableScore();

@@ -46,6 +46,12 @@ void describeMap(PreparedMap& p)
 	p.stage_seconds["edges"] += stage.Tac();
 }
 
+PreparedMapPtr PreparedMap::mirrored() const
+{
+	std::call_once(mirror_once->once, [this] { mirror_once->map = mirroredMap(*this); });
+	return mirror_once->map;
+}
+
 PreparedMapPtr mirroredMap(const PreparedMap& map)
 {
 	auto p = std::make_shared<PreparedMap>();

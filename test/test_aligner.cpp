@@ -5,11 +5,13 @@
 #include <multires_map_merge/GroundTruthPair.h>
 
 #include <gtest/gtest.h>
+
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/poses/CPosePDFGaussian.h>
 
 #include <map>
+#include <thread>
 
 #include "test_data.h"
 
@@ -172,6 +174,18 @@ TEST(PreparedMaps, AlignAsTheGridsDoAndRefuseOtherFeatureOptions)
 	EXPECT_EQ(prepared.cells.scale, from_grids.cells.scale);
 	EXPECT_EQ(prepared.confidence, from_grids.confidence);
 	EXPECT_EQ(prepared.stage_seconds.count("features"), 0u);  // paid once, in prepare
+	// The mirror check flips the reference once and keeps it with the
+	// prepared map: every later pair (and thread) gets that one.
+	CScalingGridMapAligner exhaustive;  // checks the mirror image even where the cells coincide
+	exhaustive.options.exhaustive_search = true;
+	ASSERT_EQ(exhaustive.alignScaled(*ref, *other).stage_seconds.count("mirror"), 1u) << "the mirror check did not run";
+	const auto flipped = ref->mirrored();
+	std::shared_ptr<const PreparedMap> from_another_thread;
+	std::thread([&] { from_another_thread = ref->mirrored(); }).join();
+	EXPECT_EQ(from_another_thread, flipped);
+	cv::Mat flipped_back;
+	cv::flip(flipped->classes, flipped_back, 1);
+	EXPECT_EQ(cv::countNonZero(flipped_back != ref->classes), 0);
 	// Reused the other way round: the inverse transform.
 	const auto back = aligner.alignScaled(*other, *ref);
 	ASSERT_TRUE(back.success) << back.message;

@@ -72,9 +72,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * pair's best: what calibration data is made with. */
 		bool exhaustive_search = false;
 		/** Before a pair is merged on its walls agreeing (not on coinciding
-		 * cells: exact_confidence), the other map is aligned once more
-		 * mirrored (its x axis flipped; feature hypotheses only): its
-		 * candidates are rivals. A map against its own mirror image, or a
+		 * cells: exact_confidence), the other map is aligned once more to
+		 * the reference mirrored (its x axis flipped, kept with the prepared
+		 * reference; feature hypotheses only): its candidates are rivals. A map against its own mirror image, or a
 		 * flipped map, fits at least as well mirrored and is refused
 		 * (TReturnInfo::mirror_score). */
 		bool mirror_check = true;
@@ -211,10 +211,10 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		 * where refining it again would find that candidate again. Also
 		 * `screened` (no rival, never chosen). */
 		bool converged_on_exact = false;
-		/** Found for the mirrored other map (mirror_check): a rival of
-		 * every candidate, never chosen. Its `cells` take the mirrored map's
-		 * cells (with TReturnInfo::roles_swapped: the other map's cells to
-		 * the mirrored reference's). */
+		/** Found with one map mirrored (mirror_check): a rival of every
+		 * candidate, never chosen. Its `cells` take the other map's cells to
+		 * the mirrored reference's (with TReturnInfo::roles_swapped: the
+		 * mirrored other map's cells to the reference's). */
 		bool mirrored = false;
 	};
 
@@ -250,7 +250,7 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		double score = std::numeric_limits<double>::quiet_NaN();
 		double runner_up_score = std::numeric_limits<double>::quiet_NaN();
 		double decision_value = std::numeric_limits<double>::quiet_NaN();
-		/** The best score of the mirrored other map (mirror_check; NaN where
+		/** The best score with one map mirrored (mirror_check; NaN where
 		 * the check did not run). Above `score`: a map flipped in y? */
 		double mirror_score = std::numeric_limits<double>::quiet_NaN();
 		double confidence = 0;  //!< in [0,1]

@@ -78,7 +78,7 @@ struct DecisionCandidate
 	Placement placement;
 	/** Judged on a sample and dropped there: never chosen, no rival. */
 	bool screened = false;
-	/** Found for the mirrored other map: a rival of every candidate, never chosen. */
+	/** Found with one map mirrored: a rival of every candidate, never chosen. */
 	bool mirrored = false;
 	/** TsICP's ψ: breaks ties between equally confident candidates. */
 	double objective = 0;

@@ -15,6 +15,7 @@
 
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,18 @@ struct PreparedMap
 	Eigen::Vector2d wall_centroid{0, 0};
 	OccupancyField field;
 	std::map<std::string, double> stage_seconds;  //!< features, edges
+
+	/** This map mirrored (mirroredMap), made when first asked and kept with
+	 * it: the mirror check flips the reference, and a fleet's reference
+	 * meets it in every pair. Safe to call from several threads. */
+	std::shared_ptr<const PreparedMap> mirrored() const;
+	/** mirrored()'s, made once by whichever thread asks first. */
+	struct MirrorOnce
+	{
+		std::once_flag once;
+		std::shared_ptr<const PreparedMap> map;
+	};
+	std::shared_ptr<MirrorOnce> mirror_once = std::make_shared<MirrorOnce>();
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
 
