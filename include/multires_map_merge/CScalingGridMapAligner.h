@@ -74,9 +74,9 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 		/** Before a pair is merged on its walls agreeing (not on coinciding
 		 * cells: exact_confidence), the other map is aligned once more to
 		 * the reference mirrored (its x axis flipped, kept with the prepared
-		 * reference; feature hypotheses only): its candidates are rivals. A map against its own mirror image, or a
-		 * flipped map, fits at least as well mirrored and is refused
-		 * (TReturnInfo::mirror_score). */
+		 * reference; feature hypotheses only): its candidates are rivals. A
+		 * map against its own mirror image, or a flipped map, fits at least
+		 * as well mirrored and is refused (TReturnInfo::mirror_score). */
 		bool mirror_check = true;
 		/** A pair refused with OTHER aligned onto REF is aligned once more the
 		 * other way round (REF onto OTHER) and merged if that is confident,
