@@ -38,8 +38,8 @@ const std::vector<AlignerParamField>& alignerParamFields()
 		{"exhaustive_search", &P::exhaustive_search, 0, 1, no0,
 		 "Refine every hypothesis, always search the structure and check the mirror image (calibration data)"},
 		{"mirror_check", &P::mirror_check, 0, 1, no0,
-		 "Before merging on the walls, align the other map mirrored too: its candidates are rivals, so a mirror "
-		 "image is refused"},
+		 "Before merging on the walls, align the other map to the reference mirrored too: its candidates are "
+		 "rivals, so a mirror image is refused"},
 		{"both_orders", &P::both_orders, 0, 1, no0,
 		 "A pair refused one way round is aligned the other way round too (REF onto OTHER) and merged if that is "
 		 "confident"},

@@ -180,7 +180,9 @@ CScalingGridMapAligner::TReturnInfo swappedBack(
 	for (auto& c : r.candidates)
 	{
 		c.cells = c.cells.inverse(), c.initial_cells = c.initial_cells.inverse();
-		c.other_centre = c.cells.apply(other.wall_centroid);
+		// A mirrored candidate now starts from the mirrored other map (the
+		// swapped alignment's mirrored reference, made by its mirror pass).
+		c.other_centre = c.cells.apply(c.mirrored ? other.mirrored()->wall_centroid : other.wall_centroid);
 	}
 	return r;
 }

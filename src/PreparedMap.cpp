@@ -48,8 +48,9 @@ void describeMap(PreparedMap& p)
 
 PreparedMapPtr PreparedMap::mirrored() const
 {
-	std::call_once(mirror_once->once, [this] { mirror_once->map = mirroredMap(*this); });
-	return mirror_once->map;
+	const auto& once = mirror_cache.once;
+	std::call_once(once->flag, [&] { once->map = mirroredMap(*this); });
+	return once->map;
 }
 
 PreparedMapPtr mirroredMap(const PreparedMap& map)

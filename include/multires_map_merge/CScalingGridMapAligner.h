@@ -324,8 +324,8 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	/** The search, decision and finish of one pair (a given start first). */
 	TReturnInfo align(
 		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
-	/** mirror_check: the other map aligned mirrored (feature hypotheses
-	 * only); its candidates join `search` as rivals. Returns their best
+	/** mirror_check: the other map aligned to the reference mirrored
+	 * (feature hypotheses only); its candidates join `search` as rivals. Returns their best
 	 * score (NaN with none judged in full). */
 	double mirrorPass(const TPreparedMap& ref, const TPreparedMap& other, pair_search::SearchState& search) const;
 };

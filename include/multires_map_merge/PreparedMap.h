@@ -43,16 +43,29 @@ struct PreparedMap
 	std::map<std::string, double> stage_seconds;  //!< features, edges
 
 	/** This map mirrored (mirroredMap), made when first asked and kept with
-	 * it: the mirror check flips the reference, and a fleet's reference
-	 * meets it in every pair. Safe to call from several threads. */
+	 * it (as much memory again): the mirror check flips the reference, and a
+	 * fleet's reference meets it in every pair. Safe to call from several
+	 * threads. */
 	std::shared_ptr<const PreparedMap> mirrored() const;
-	/** mirrored()'s, made once by whichever thread asks first. */
-	struct MirrorOnce
+	/** mirrored()'s, made once by whichever thread asks first. A copy of
+	 * the map starts without one: it may be changed before it is mirrored. */
+	struct MirrorCache
 	{
-		std::once_flag once;
-		std::shared_ptr<const PreparedMap> map;
+		struct Once
+		{
+			std::once_flag flag;
+			std::shared_ptr<const PreparedMap> map;
+		};
+		std::shared_ptr<Once> once = std::make_shared<Once>();
+		MirrorCache() = default;
+		MirrorCache(const MirrorCache&) {}
+		MirrorCache& operator=(const MirrorCache&)
+		{
+			once = std::make_shared<Once>();
+			return *this;
+		}
 	};
-	std::shared_ptr<MirrorOnce> mirror_once = std::make_shared<MirrorOnce>();
+	MirrorCache mirror_cache;
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
 
