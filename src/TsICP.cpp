@@ -87,20 +87,14 @@ Similarity2D fitSimilarity(
 
 namespace
 {
-/** ψ(ξ) of `t` on the pairs of every reference point. */
-double objectiveAt(const PointList& ref, const PointKDTree& other_tree, const Similarity2D& t, const TsICPParams& p)
-{
-	return trim(backwardPairs(ref, other_tree, t), p).objective;
-}
-
-/** The iterations of TsICP on a fixed point set. */
+/** The iterations of TsICP on a fixed point set, from `start` and its
+ * pairs (backwardPairs of `start`). */
 TsICPResult iterate(
 	const PointList& ref, const PointList& other, const PointKDTree& other_tree, const Similarity2D& start,
-	const TsICPParams& p, int max_iterations)
+	std::vector<Pair> pairs, const TsICPParams& p, int max_iterations)
 {
 	TsICPResult r;
 	r.transform = start;
-	auto pairs = backwardPairs(ref, other_tree, r.transform);
 	Trimming t = trim(pairs, p);
 	r.objective_history.push_back(t.objective);
 
@@ -160,17 +154,26 @@ TsICPResult runTsICP(
 		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
 
 	if (p.coarse_points <= 0 || ref.size() <= 2 * size_t(p.coarse_points))
-		return iterate(ref, other, other_tree, start, p, p.max_iterations);
+		return iterate(ref, other, other_tree, start, backwardPairs(ref, other_tree, start), p, p.max_iterations);
 
 	// Coarse: every k-th reference point.
 	const PointList sample = strided(ref, size_t(p.coarse_points));
-	const TsICPResult coarse = iterate(sample, other, other_tree, start, p, p.max_iterations);
+	const TsICPResult coarse =
+		iterate(sample, other, other_tree, start, backwardPairs(sample, other_tree, start), p, p.max_iterations);
 	// Fine: on all points, from the coarse result unless (rarely) it is worse
-	// there than the start.
-	const double at_start = objectiveAt(ref, other_tree, start, p);
-	const bool better = coarse.transform.isFinite() && objectiveAt(ref, other_tree, coarse.transform, p) <= at_start;
+	// there than the start; the pairs of whichever it starts from are the
+	// fine phase's first.
+	auto start_pairs = backwardPairs(ref, other_tree, start);
+	const double at_start = trim(start_pairs, p).objective;
+	bool better = false;
+	if (coarse.transform.isFinite())
+	{
+		auto coarse_pairs = backwardPairs(ref, other_tree, coarse.transform);
+		better = trim(coarse_pairs, p).objective <= at_start;
+		if (better) start_pairs = std::move(coarse_pairs);
+	}
 	TsICPResult r = iterate(
-		ref, other, other_tree, better ? coarse.transform : start, p,
+		ref, other, other_tree, better ? coarse.transform : start, std::move(start_pairs), p,
 		std::max(1, p.max_iterations - (better ? coarse.iterations : 0)));
 	if (better) r.objective_history.insert(r.objective_history.begin(), at_start);
 	r.iterations += coarse.iterations;
