@@ -1,4 +1,5 @@
 #include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/FleetGraph.h>
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/FeatureHypotheses.h>
 #include <multires_map_merge/GridImage.h>
@@ -25,64 +26,15 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
-namespace
-{
-/** What a pair's precision allows (cycle_tolerance_per_rmse × its edge RMSE), unclamped. */
-double byPrecision(const FleetParams& p, const FleetEdge& e)
-{
-	const double cells = p.cycle_tolerance_per_rmse * e.rmse_coarse_cells;
-	return std::isfinite(cells) ? cells : 0.0;
-}
-
-/** `cells` within cycle_tolerance_cells and the largest tolerance. */
-double withinToleranceBounds(const FleetParams& p, double cells)
-{
-	return std::clamp(cells, p.cycle_tolerance_cells, std::max(p.cycle_tolerance_cells, p.maxToleranceCells()));
-}
-}  // namespace
-
-double FleetParams::toleranceOf(const FleetEdge& e) const { return withinToleranceBounds(*this, byPrecision(*this, e)); }
-
-double FleetParams::cycleTolerance(
-	const std::vector<int>& cycle, const std::vector<FleetEdge>& edges, const std::vector<double>& coarse_cell) const
-{
-	// Each pair's error adds to the cycle's closure independently: they add
-	// in quadrature (a direct pair and a chain of three bent pairs disagree
-	// by about the chain's errors combined, not by one pair's).
-	double sum_sq = 0;
-	for (int c : cycle)
-	{
-		const double in_closing_cells = coarse_cell.empty() ? 1.0 : coarse_cell[size_t(c)] / coarse_cell[size_t(cycle[0])];
-		sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]) * in_closing_cells, 2);
-	}
-	return withinToleranceBounds(*this, std::sqrt(sum_sq));
-}
-
-namespace
-{
-/** The cells of the coarser map of the pair `e`, in `e.to`'s metres. */
 double coarseCellInTo(const std::vector<GridInFrame>& maps, const FleetEdge& e)
 {
 	return std::max<double>(maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
 }
-}  // namespace
 
 double coarseCellInReference(
 	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
 {
 	return coarseCellInTo(maps, e) * placements[e.to].in_reference.scale;
-}
-
-FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
-{
-	FleetParams p = *this;
-	if (!(p.cycle_tolerance_max_cells > 0)) p.cycle_tolerance_max_cells = decision.distinct_shift;
-	return p;
-}
-
-double FleetParams::maxToleranceCells() const
-{
-	return cycle_tolerance_max_cells > 0 ? cycle_tolerance_max_cells : DecisionParams{}.distinct_shift;
 }
 
 std::string FleetEdge::describe() const
@@ -275,147 +227,6 @@ std::vector<std::optional<FleetEdge>> alignPairs(
 	return out;
 }
 
-/** How far `predicted` (from → to) puts what `from` saw from where the pair
- * `e` puts it, in cells of the coarser map of the pair. */
-double disagreementCells(
-	const std::vector<GridInFrame>& maps, const WallSpread& from_spread, const FleetEdge& e,
-	const Similarity2D& predicted)
-{
-	return wallRms(from_spread, predicted, e.from_to_to) / coarseCellInTo(maps, e);
-}
-
-struct Tree
-{
-	std::vector<FleetPlacement> maps;
-	std::vector<int> via_edge;  // the tree edge placing each map (-1: none)
-	/** Per map, the largest tolerance of a cycle it lies on (0: none; set
-	 * by consistentTree): how far the cycle check let the pairs around it
-	 * disagree, so how far the joint refinement may move it. */
-	std::vector<double> cycle_tolerance;
-};
-
-/** Maximum spanning tree from the reference over the confident, kept edges
- * (Prim): each map joins through the most confident edge to the placed
- * part, so its path is the most confident one (as sure as its weakest edge).
- * Confidences of `sure` and above count as one: among sure paths the one of
- * fewest pairs wins, since each pair adds its own error (bent maps: a few
- * cells each) and a surer-by-a-hair chain only adds more. */
-Tree spanningTree(size_t n, size_t reference, const std::vector<FleetEdge>& edges, double sure)
-{
-	Tree t;
-	t.maps.assign(n, {});
-	t.via_edge.assign(n, -1);
-	t.maps[reference].placed = true;
-	t.maps[reference].confidence = 1;
-	t.maps[reference].message = "reference";
-	std::vector<size_t> hops(n, 0);
-	auto anchorOf = [&](const FleetEdge& e) { return t.maps[e.from].placed ? e.from : e.to; };
-	auto better = [&](const FleetEdge& a, const FleetEdge& b) {
-		const double ca = std::min(a.confidence, sure), cb = std::min(b.confidence, sure);
-		if (ca != cb) return ca > cb;
-		if (hops[anchorOf(a)] != hops[anchorOf(b)]) return hops[anchorOf(a)] < hops[anchorOf(b)];
-		return a.confidence > b.confidence;
-	};
-	for (;;)
-	{
-		int best = -1;
-		for (size_t k = 0; k < edges.size(); ++k)
-		{
-			const FleetEdge& e = edges[k];
-			if (!e.merged || e.dropped || t.maps[e.from].placed == t.maps[e.to].placed) continue;
-			if (best < 0 || better(e, edges[best])) best = static_cast<int>(k);
-		}
-		if (best < 0) break;
-		const FleetEdge& e = edges[best];
-		const bool from_new = !t.maps[e.from].placed;
-		const size_t added = from_new ? e.from : e.to, anchor = from_new ? e.to : e.from;
-		hops[added] = hops[anchor] + 1;
-		FleetPlacement& p = t.maps[added];
-		p.placed = true;
-		p.in_reference = from_new ? t.maps[anchor].in_reference.compose(e.from_to_to)
-								  : t.maps[anchor].in_reference.compose(e.from_to_to.inverse());
-		p.confidence = std::min(t.maps[anchor].confidence, e.confidence);
-		p.parent = static_cast<int>(anchor);
-		std::ostringstream how;
-		how << "placed through map " << anchor << " (pair confidence " << e.confidence << ")";
-		p.message = how.str();
-		t.via_edge[added] = best;
-	}
-	return t;
-}
-
-/** Tree edges on the path from `a` to the reference. */
-std::vector<int> pathEdges(const Tree& t, size_t a)
-{
-	std::vector<int> out;
-	for (int m = static_cast<int>(a); t.via_edge[m] >= 0; m = t.maps[m].parent) out.push_back(t.via_edge[m]);
-	return out;
-}
-
-/** The cycle that non-tree edge k closes with the tree: k and both tree
- * paths up to where they meet (the part they share towards the reference is
- * not on the cycle). */
-std::vector<int> cycleOf(const Tree& t, const std::vector<FleetEdge>& edges, int k)
-{
-	const std::vector<int> up_from = pathEdges(t, edges[k].from), up_to = pathEdges(t, edges[k].to);
-	std::vector<int> cycle = {k};
-	for (const auto* path : {&up_from, &up_to})
-		for (int e : *path)
-			if (std::count(up_from.begin(), up_from.end(), e) + std::count(up_to.begin(), up_to.end(), e) == 1)
-				cycle.push_back(e);
-	return cycle;
-}
-
-/** Edge k is kept, joins two placed maps and is not on the tree: it closes a cycle. */
-bool closesACycle(const Tree& t, const std::vector<FleetEdge>& edges, size_t k)
-{
-	const FleetEdge& e = edges[k];
-	return e.merged && !e.dropped && t.maps[e.from].placed && t.maps[e.to].placed && t.via_edge[e.from] != int(k) &&
-		t.via_edge[e.to] != int(k);
-}
-
-/** Each edge's coarser cells in the reference's metres (0 where `to` is not placed). */
-std::vector<double> coarseCells(const std::vector<GridInFrame>& maps, const Tree& t, const std::vector<FleetEdge>& edges)
-{
-	std::vector<double> out;
-	for (const auto& e : edges) out.push_back(t.maps[e.to].placed ? coarseCellInReference(maps, t.maps, e) : 0.0);
-	return out;
-}
-
-/** Builds the tree; while a kept non-tree edge contradicts it (by more than
- * the cycle's tolerance), drops the weakest edge of that cycle and rebuilds.
- * The tree returned holds every map's largest cycle tolerance. */
-Tree consistentTree(
-	const std::vector<GridInFrame>& maps, const std::vector<WallSpread>& spread, size_t reference,
-	std::vector<FleetEdge>& edges, const FleetParams& params)
-{
-	for (;;)
-	{
-		Tree t = spanningTree(maps.size(), reference, edges, params.settled_confidence);
-		std::vector<int> contradicted;
-		t.cycle_tolerance.assign(maps.size(), 0.0);
-		const std::vector<double> cells = coarseCells(maps, t, edges);
-		for (size_t k = 0; k < edges.size() && contradicted.empty(); ++k)
-		{
-			if (!closesACycle(t, edges, k)) continue;
-			const FleetEdge& e = edges[k];
-			const std::vector<int> cycle = cycleOf(t, edges, int(k));
-			const double tol = params.cycleTolerance(cycle, edges, cells);
-			const Similarity2D predicted = t.maps[e.to].in_reference.inverse().compose(t.maps[e.from].in_reference);
-			if (disagreementCells(maps, spread[e.from], e, predicted) > tol)
-				contradicted = cycle;
-			for (int c : cycle)
-				for (size_t m : {edges[size_t(c)].from, edges[size_t(c)].to})
-					t.cycle_tolerance[m] = std::max(t.cycle_tolerance[m], tol);
-		}
-		if (contradicted.empty()) return t;
-		const int weakest = *std::min_element(contradicted.begin(), contradicted.end(), [&](int a, int b) {
-			return edges[a].confidence < edges[b].confidence;
-		});
-		edges[weakest].dropped = true;
-	}
-}
-
 using PairKey = std::pair<size_t, size_t>;  // (lower, higher) map index
 PairKey keyOf(size_t a, size_t b) { return {std::min(a, b), std::max(a, b)}; }
 
@@ -490,37 +301,6 @@ PairList nextPairs(
 	}
 }
 
-/** Per map: whether its placement hangs on one pair, i.e. one confident pair
- * kept, taken out, leaves it connected to the reference by nothing (a
- * bridge). Then no second, independent path checks it around a cycle or
- * refines it jointly: a wrong or imprecise pair would go unseen. */
-std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
-{
-	const size_t n = f.maps.size();
-	std::vector<size_t> kept;
-	for (size_t k = 0; k < f.edges.size(); ++k)
-		if (f.edges[k].merged && !f.edges[k].dropped) kept.push_back(k);
-	std::vector<bool> out(n, false);
-	for (size_t cut : kept)
-	{
-		std::vector<bool> reached(n, false);
-		reached[reference] = true;
-		for (bool grew = true; grew;)
-		{
-			grew = false;
-			for (size_t k : kept)
-			{
-				const FleetEdge& e = f.edges[k];
-				if (k == cut || reached[e.from] == reached[e.to]) continue;
-				reached[e.from] = reached[e.to] = true;
-				grew = true;
-			}
-		}
-		for (size_t m = 0; m < n; ++m) out[m] = out[m] || (f.maps[m].placed && !reached[m]);
-	}
-	return out;
-}
-
 /** Each map's wall spread, from its prepared class image where it has one. */
 std::vector<WallSpread> wallSpreadOf(const std::vector<GridInFrame>& maps, const PreparedMaps& prepared = {})
 {
@@ -538,7 +318,7 @@ FleetResult placeFromPairs(
 	std::vector<FleetEdge> edges, const FleetParams& params)
 {
 	FleetResult out;
-	const Tree tree = consistentTree(maps, spread, reference, edges, params);
+	const PlacementTree tree = consistentTree(maps, spread, reference, edges, params);
 	out.edges = std::move(edges);
 	out.maps = tree.maps;
 	if (params.joint_refinement)

@@ -1,9 +1,12 @@
 // The fleet's parameters: one list (key, member, range, meaning) that
-// loading, saving, validation, the ROS nodes and docs/parameters.md's table all read.
+// loading, saving, validation, the ROS nodes and docs/parameters.md's table all read;
+// and the tolerances they give a pair and a cycle.
 #include <multires_map_merge/FleetMerge.h>
 
 #include "ParamText.h"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -65,6 +68,51 @@ std::string fleetParamsMarkdown()
 	for (const auto& f : fleetParamFields())
 		md << markdownRow(defaults, f.member, f.key, f.lo, f.hi, f.zero_is_default, f.description);
 	return md.str();
+}
+
+namespace
+{
+/** What a pair's precision allows (cycle_tolerance_per_rmse × its edge RMSE), unclamped. */
+double byPrecision(const FleetParams& p, const FleetEdge& e)
+{
+	const double cells = p.cycle_tolerance_per_rmse * e.rmse_coarse_cells;
+	return std::isfinite(cells) ? cells : 0.0;
+}
+
+/** `cells` within cycle_tolerance_cells and the largest tolerance. */
+double withinToleranceBounds(const FleetParams& p, double cells)
+{
+	return std::clamp(cells, p.cycle_tolerance_cells, std::max(p.cycle_tolerance_cells, p.maxToleranceCells()));
+}
+}  // namespace
+
+double FleetParams::toleranceOf(const FleetEdge& e) const { return withinToleranceBounds(*this, byPrecision(*this, e)); }
+
+double FleetParams::cycleTolerance(
+	const std::vector<int>& cycle, const std::vector<FleetEdge>& edges, const std::vector<double>& coarse_cell) const
+{
+	// Each pair's error adds to the cycle's closure independently: they add
+	// in quadrature (a direct pair and a chain of three bent pairs disagree
+	// by about the chain's errors combined, not by one pair's).
+	double sum_sq = 0;
+	for (int c : cycle)
+	{
+		const double in_closing_cells = coarse_cell.empty() ? 1.0 : coarse_cell[size_t(c)] / coarse_cell[size_t(cycle[0])];
+		sum_sq += std::pow(byPrecision(*this, edges[size_t(c)]) * in_closing_cells, 2);
+	}
+	return withinToleranceBounds(*this, std::sqrt(sum_sq));
+}
+
+FleetParams FleetParams::resolvedFor(const DecisionParams& decision) const
+{
+	FleetParams p = *this;
+	if (!(p.cycle_tolerance_max_cells > 0)) p.cycle_tolerance_max_cells = decision.distinct_shift;
+	return p;
+}
+
+double FleetParams::maxToleranceCells() const
+{
+	return cycle_tolerance_max_cells > 0 ? cycle_tolerance_max_cells : DecisionParams{}.distinct_shift;
 }
 
 }  // namespace multires_map_merge

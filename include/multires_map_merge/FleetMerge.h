@@ -3,7 +3,7 @@
 // confident similarities; every map is placed through its most confident
 // path from the reference (maximum spanning tree, a path as sure as its
 // weakest edge); an aligned pair that contradicts the tree around a cycle
-// drops the weakest edge of that cycle; then every placement is refined at
+// drops the weakest edge of that cycle (FleetGraph.h); then every placement is refined at
 // once from all confident pairs kept (JointPlacement.h); the placed maps are
 // fused with the two-map cell rule. A map that nothing confident connects is reported by
 // name as not placed: never dropped silently, never placed on a guess.
@@ -207,6 +207,8 @@ struct FleetResult
 	bool allPlaced() const;
 };
 
+/** The cells of the coarser map of the pair `e`, in `e.to`'s metres. */
+double coarseCellInTo(const std::vector<GridInFrame>& maps, const FleetEdge& e);
 /** The cells of the coarser map of the pair `e` in the reference's metres,
  * `e.to` placed by `placements`: what the pair's RMSE and tolerance count. */
 double coarseCellInReference(
