@@ -137,12 +137,13 @@ PlacementTree consistentTree(
 	}
 }
 
-std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
+std::vector<bool> hangsOnOnePair(
+	const std::vector<FleetPlacement>& placements, const std::vector<FleetEdge>& edges, size_t reference)
 {
-	const size_t n = f.maps.size();
+	const size_t n = placements.size();
 	std::vector<size_t> kept;
-	for (size_t k = 0; k < f.edges.size(); ++k)
-		if (f.edges[k].merged && !f.edges[k].dropped) kept.push_back(k);
+	for (size_t k = 0; k < edges.size(); ++k)
+		if (edges[k].merged && !edges[k].dropped) kept.push_back(k);
 	std::vector<bool> out(n, false);
 	for (size_t cut : kept)
 	{
@@ -153,13 +154,13 @@ std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference)
 			grew = false;
 			for (size_t k : kept)
 			{
-				const FleetEdge& e = f.edges[k];
+				const FleetEdge& e = edges[k];
 				if (k == cut || reached[e.from] == reached[e.to]) continue;
 				reached[e.from] = reached[e.to] = true;
 				grew = true;
 			}
 		}
-		for (size_t m = 0; m < n; ++m) out[m] = out[m] || (f.maps[m].placed && !reached[m]);
+		for (size_t m = 0; m < n; ++m) out[m] = out[m] || (placements[m].placed && !reached[m]);
 	}
 	return out;
 }

@@ -6,7 +6,6 @@
 #include <multires_map_merge/GridMapFusion.h>
 #include <multires_map_merge/JointPlacement.h>
 
-#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -26,65 +25,8 @@ bool FleetResult::allPlaced() const
 	return std::all_of(maps.begin(), maps.end(), [](const FleetPlacement& p) { return p.placed; });
 }
 
-double coarseCellInTo(const std::vector<GridInFrame>& maps, const FleetEdge& e)
-{
-	return std::max<double>(maps[e.to].grid.getResolution(), maps[e.from].grid.getResolution() * e.from_to_to.scale);
-}
-
-double coarseCellInReference(
-	const std::vector<GridInFrame>& maps, const std::vector<FleetPlacement>& placements, const FleetEdge& e)
-{
-	return coarseCellInTo(maps, e) * placements[e.to].in_reference.scale;
-}
-
-std::string FleetEdge::describe() const
-{
-	return dropped ? "dropped: contradicts the other alignments around a cycle (" + message + ")" : message;
-}
-
-double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b)
-{
-	const Similarity2D cells = map.cellToMapFrame();
-	const double w = map.grid.getSizeX() - 1, h = map.grid.getSizeY() - 1;
-	double se = 0;
-	for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)})
-		se += (a(cells(c)) - b(cells(c))).squaredNorm();
-	return std::sqrt(se / 4);
-}
-
 namespace
 {
-/** Four points with the mean and the spread of `cells` (cell coordinates,
- * at least one), in the map's frame (`to_frame`): see WallSpread. */
-WallSpread spreadOf(const PointList& cells, const Similarity2D& to_frame)
-{
-	Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-	for (const auto& p : cells) mean += p;
-	mean /= double(cells.size());
-	Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-	for (const auto& p : cells) cov += (p - mean) * (p - mean).transpose();
-	cov /= double(cells.size());
-	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-	WallSpread out;
-	for (int axis = 0; axis < 2; ++axis)
-	{
-		const Eigen::Vector2d half = std::sqrt(2 * std::max(0.0, eig.eigenvalues()[axis])) * eig.eigenvectors().col(axis);
-		out[2 * axis] = to_frame(mean + half);
-		out[2 * axis + 1] = to_frame(mean - half);
-	}
-	return out;
-}
-
-/** wallSpread from the map's class image (GridImage.h). */
-WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes)
-{
-	// Its walls; a map with almost none: what it saw; nothing: the whole grid.
-	PointList cells_seen = occupiedPoints(classes);
-	if (cells_seen.size() < 3) cells_seen = cellsOf(classes != kUnknown);
-	if (cells_seen.size() < 3) cells_seen = cellsOf(cv::Mat::ones(classes.size(), CV_8U));
-	return spreadOf(cells_seen, map.cellToMapFrame());
-}
-
 /** The WallSpread of `from`'s walls that `cells` (from's cells → to's)
  * puts on space `to` saw (FleetEdge::overlap); none with fewer than three. */
 std::optional<WallSpread> overlapSpread(
@@ -97,19 +39,7 @@ std::optional<WallSpread> overlapSpread(
 	if (shared.size() < 3) return std::nullopt;
 	return spreadOf(shared, from.cellToMapFrame());
 }
-}  // namespace
 
-WallSpread wallSpread(const GridInFrame& map) { return wallSpread(map, toClassImage(map.grid)); }
-
-double wallRms(const WallSpread& spread, const Similarity2D& a, const Similarity2D& b)
-{
-	double se = 0;
-	for (const auto& p : spread) se += (a(p) - b(p)).squaredNorm();
-	return std::sqrt(se / spread.size());
-}
-
-namespace
-{
 using PairList = std::vector<std::pair<size_t, size_t>>;  // (to, from): `from` aligned onto `to`
 
 /** Runs work(k, aligner) for k in [0, count) on a small pool of threads,
@@ -331,7 +261,7 @@ FleetResult placeFromPairs(
 			if (joint[m])
 				out.maps[m].in_reference = *joint[m], out.maps[m].message += ", refined jointly with every confident pair";
 	}
-	const std::vector<bool> on_one_pair = hangsOnOnePair(out, reference);
+	const std::vector<bool> on_one_pair = hangsOnOnePair(out.maps, out.edges, reference);
 	for (size_t m = 0; m < maps.size(); ++m)
 		if (m != reference && out.maps[m].placed && !on_one_pair[m])
 			out.maps[m].checked_by_cycle = true, out.maps[m].message += ", checked by a cycle";

@@ -1,7 +1,7 @@
 // The fleet's parameters: one list (key, member, range, meaning) that
 // loading, saving, validation, the ROS nodes and docs/parameters.md's table all read;
 // and the tolerances they give a pair and a cycle.
-#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/FleetParams.h>
 
 #include "ParamText.h"
 

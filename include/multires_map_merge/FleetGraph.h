@@ -4,7 +4,9 @@
 // spanning tree), a pair that contradicts the tree around a cycle taken as a
 // sign that one pair of that cycle is wrong (its weakest is dropped), and
 // which maps hang on one pair, with no second path to check them.
-#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/FleetEdge.h>
+#include <multires_map_merge/FleetParams.h>
+#include <multires_map_merge/WallSpread.h>
 
 #include <vector>
 
@@ -32,6 +34,7 @@ PlacementTree consistentTree(
  * kept, taken out, leaves it connected to the reference by nothing (a
  * bridge). Then no second, independent path checks it around a cycle or
  * refines it jointly: a wrong or imprecise pair would go unseen. */
-std::vector<bool> hangsOnOnePair(const FleetResult& f, size_t reference);
+std::vector<bool> hangsOnOnePair(
+	const std::vector<FleetPlacement>& placements, const std::vector<FleetEdge>& edges, size_t reference);
 
 }  // namespace multires_map_merge

@@ -6,7 +6,8 @@
 // best with all of them at once are found by linear least squares, because a
 // 2-D similarity is a complex affine map z ↦ a·z + b (a = s·e^{iθ}), and
 // "pair (f → t) says T_f = T_t ∘ M" is linear in (a, b) of both maps.
-#include <multires_map_merge/FleetMerge.h>
+#include <multires_map_merge/FleetEdge.h>
+#include <multires_map_merge/WallSpread.h>
 
 #include <optional>
 #include <vector>
