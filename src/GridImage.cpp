@@ -4,13 +4,6 @@
 
 namespace multires_map_merge
 {
-CellClass classify(float p)
-{
-	if (p > kOccupiedAbove) return kOccupied;
-	if (p < kFreeBelow) return kFree;
-	return kUnknown;
-}
-
 cv::Mat toClassImage(const mrpt::maps::COccupancyGridMap2D& grid)
 {
 	const int w = static_cast<int>(grid.getSizeX()), h = static_cast<int>(grid.getSizeY());

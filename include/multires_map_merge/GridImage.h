@@ -27,7 +27,14 @@ enum CellClass : uint8_t
 constexpr float kOccupiedAbove = 0.505f;
 constexpr float kFreeBelow = 0.495f;
 
-CellClass classify(float occupancy_probability);
+/** The class of an occupancy probability (inline: the fusion asks it for
+ * every sample of every map). */
+inline CellClass classify(float occupancy_probability)
+{
+	if (occupancy_probability > kOccupiedAbove) return kOccupied;
+	if (occupancy_probability < kFreeBelow) return kFree;
+	return kUnknown;
+}
 
 /** Occupancy probability of a cell (MRPT stores the probability of *free*). */
 inline float occupancyProbability(const mrpt::maps::COccupancyGridMap2D& g, int cx, int cy)
