@@ -292,11 +292,24 @@ ShiftField shiftField(
 		for (const auto& p : pts)
 			x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
 		x0 -= r, y0 -= r, x1 += r, y1 += r;
+		// Per window cell what a point landing there is worth (+1 supported,
+		// -1 conflicting) and whether it is judged at all; per point its
+		// index unshifted: every shift adds one offset to all of them.
 		const int window_w = x1 - x0 + 1;
-		std::vector<Landing> window(size_t(window_w) * size_t(y1 - y0 + 1), Landing::Unjudged);
+		const size_t window_cells = size_t(window_w) * size_t(y1 - y0 + 1);
+		std::vector<int8_t> worth(window_cells, 0);
+		std::vector<uint8_t> judged_at(window_cells, 0);
 		for (int y = std::max(0, y0); y <= std::min(h - 1, y1); ++y)
 			for (int x = std::max(0, x0); x <= std::min(w - 1, x1); ++x)
-				window[size_t(y - y0) * window_w + size_t(x - x0)] = landing(target, x, y, tolerance);
+			{
+				const Landing l = landing(target, x, y, tolerance);
+				const size_t i = size_t(y - y0) * window_w + size_t(x - x0);
+				worth[i] = l == Landing::Supported ? 1 : l == Landing::Conflicting ? -1 : 0;
+				judged_at[i] = l != Landing::Unjudged;
+			}
+		std::vector<ptrdiff_t> unshifted(pts.size());
+		for (size_t k = 0; k < pts.size(); ++k)
+			unshifted[k] = ptrdiff_t(pts[k].y - y0) * window_w + ptrdiff_t(pts[k].x - x0);
 		long best_value = std::numeric_limits<long>::min();
 		int best_norm = 0;
 		bool judged = false;
@@ -305,14 +318,15 @@ ShiftField shiftField(
 			for (int ix = -steps; ix <= steps; ++ix)
 			{
 				const cv::Point d(int(std::lround(ix * step)), int(std::lround(iy * step)));
+				const ptrdiff_t offset = ptrdiff_t(d.y) * window_w + d.x;
 				long value = 0;
-				bool any = false;
-				for (const auto& p : pts)
+				unsigned any_judged = 0;
+				for (const ptrdiff_t i : unshifted)
 				{
-					const Landing l = window[size_t(p.y + d.y - y0) * window_w + size_t(p.x + d.x - x0)];
-					any = any || l != Landing::Unjudged;
-					value += l == Landing::Supported ? 1 : l == Landing::Conflicting ? -1 : 0;
+					value += worth[size_t(i + offset)];
+					any_judged |= judged_at[size_t(i + offset)];
 				}
+				const bool any = any_judged != 0;
 				const int norm = d.x * d.x + d.y * d.y;
 				if (any && (value > best_value || (value == best_value && norm < best_norm)))
 					best_value = value, best_norm = norm, best = d, judged = true;
