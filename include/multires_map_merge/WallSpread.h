@@ -31,14 +31,14 @@ WallSpread spreadOf(const PointList& cells, const Similarity2D& to_frame);
  * occupied cells; with fewer than three, its known cells; none known, the
  * whole grid. */
 WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes);
-/** RMS distance (metres of the target frame) between where two transforms
- * put the four corners of `map`'s grid: how far apart two placements of a
- * map are. */
-double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
-
-/** The WallSpread of a map (see WallSpread). */
+/** The same from the map's grid. */
 WallSpread wallSpread(const GridInFrame& map);
+
 /** RMS distance between where two transforms put a map's walls (its WallSpread). */
 double wallRms(const WallSpread& spread, const Similarity2D& a, const Similarity2D& b);
+/** RMS distance (metres of the target frame) between where two transforms
+ * put the four corners of `map`'s grid: how far apart two placements of a
+ * map's grid are (its padding of unknown space counted too). */
+double cornerRms(const GridInFrame& map, const Similarity2D& a, const Similarity2D& b);
 
 }  // namespace multires_map_merge
