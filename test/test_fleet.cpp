@@ -3,6 +3,7 @@
 // own frames with off-lattice origins, where the fourth robot's part of the
 // run overlaps only the third's; plus a robot of another building (intel),
 // which must stay out, named.
+#include <multires_map_merge/FleetGraph.h>
 #include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
@@ -366,6 +367,27 @@ void expectNear(const Similarity2D& a, const Similarity2D& b)
 	EXPECT_NEAR((a.t - b.t).norm(), 0, 1e-9);
 }
 }  // namespace
+
+TEST(FleetGraph, AMapHangsOnOnePairWhereNoSecondPathOfKeptPairsReachesIt)
+{
+	// 0-1-2 a cycle (each map has two paths); 3 joined to 2 by one kept
+	// pair, its other pairs refused (0 <- 3) or dropped by a cycle (1 <- 3);
+	// 4 not placed.
+	std::vector<FleetEdge> edges = {edge(1, 0, {}, 1), edge(2, 1, {}, 1), edge(2, 0, {}, 1), edge(3, 2, {}, 1),
+									edge(3, 1, {}, 1), edge(3, 0, {}, 0.2)};
+	edges[4].dropped = true;
+	edges[5].merged = false;
+	std::vector<FleetPlacement> placements(5);
+	for (size_t m = 0; m < 4; ++m) placements[m].placed = true;
+	EXPECT_EQ(multires_map_merge::hangsOnOnePair(placements, edges, 0), std::vector<bool>({false, false, false, true, false}));
+	// The pair dropped by the cycle kept after all: a second path for 3.
+	edges[4].dropped = false;
+	EXPECT_EQ(multires_map_merge::hangsOnOnePair(placements, edges, 0), std::vector<bool>(5, false));
+	// Without the closing pair 0 <- 2, 1 and 2 hang on the chain too.
+	edges[4].dropped = true;
+	edges[2].merged = false;
+	EXPECT_EQ(multires_map_merge::hangsOnOnePair(placements, edges, 0), std::vector<bool>({false, true, true, true, false}));
+}
 
 TEST(FleetGraph, AContradictedCycleDropsItsWeakestPairNotTheSharedPath)
 {
