@@ -2,7 +2,7 @@
 // Edge points: occupied cells that border free space, the structure both maps
 // share whatever their resolution. TsICP registers these.
 
-#include <multires_map_merge/TsICP.h>
+#include <multires_map_merge/PointList.h>
 
 #include <opencv2/core.hpp>
 

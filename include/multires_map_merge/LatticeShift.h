@@ -8,7 +8,7 @@
 // and no fewer, undoes it. Walls two cells thick let a fit slip a whole cell
 // (one face on the other): the whole-cell shifts are compared first.
 
-#include <multires_map_merge/TsICP.h>
+#include <multires_map_merge/PointList.h>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>

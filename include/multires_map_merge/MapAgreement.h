@@ -5,8 +5,8 @@
 // when both maps have many similar walls.
 
 #include <multires_map_merge/GridInFrame.h>
+#include <multires_map_merge/PointList.h>
 #include <multires_map_merge/Similarity2D.h>
-#include <multires_map_merge/TsICP.h>
 
 #include <opencv2/core.hpp>
 

@@ -3,7 +3,7 @@
 // with MRPT). Built once per point set and kept with it (a prepared map holds
 // one for its edge points, which every hypothesis's TsICP queries).
 
-#include <multires_map_merge/TsICP.h>
+#include <multires_map_merge/PointList.h>
 
 #include <memory>
 

@@ -4,13 +4,13 @@
 // transformed other point) and an overlap ξ chosen each iteration to minimise
 // ψ(ξ) = e(ξ) / ξ^(1+λ).
 
+#include <multires_map_merge/PointList.h>
 #include <multires_map_merge/Similarity2D.h>
 
 #include <vector>
 
 namespace multires_map_merge
 {
-using PointList = std::vector<Eigen::Vector2d>;
 class PointKDTree;
 
 struct TsICPParams

@@ -4,8 +4,8 @@
 // fleet's cycle check and joint refinement, and the benchmarks, measure a
 // placement so.
 #include <multires_map_merge/GridInFrame.h>
+#include <multires_map_merge/PointList.h>
 #include <multires_map_merge/Similarity2D.h>
-#include <multires_map_merge/TsICP.h>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
