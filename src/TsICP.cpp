@@ -87,30 +87,44 @@ Similarity2D fitSimilarity(
 
 namespace
 {
+/** Pairs (backwardPairs of a transform) and their trimming. */
+struct Trimmed
+{
+	std::vector<Pair> pairs;
+	Trimming trimming;
+};
+Trimmed trimmedPairs(
+	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref, const TsICPParams& p)
+{
+	Trimmed out{backwardPairs(ref, other_tree, other_to_ref), {}};
+	out.trimming = trim(out.pairs, p);
+	return out;
+}
+
 /** The iterations of TsICP on a fixed point set, from `start` and its
- * pairs (backwardPairs of `start`). */
+ * trimmed pairs. */
 TsICPResult iterate(
 	const PointList& ref, const PointList& other, const PointKDTree& other_tree, const Similarity2D& start,
-	std::vector<Pair> pairs, const TsICPParams& p, int max_iterations)
+	Trimmed at_start, const TsICPParams& p, int max_iterations)
 {
 	TsICPResult r;
 	r.transform = start;
-	Trimming t = trim(pairs, p);
+	std::vector<Pair> pairs = std::move(at_start.pairs);
+	Trimming t = at_start.trimming;
 	r.objective_history.push_back(t.objective);
 
 	for (r.iterations = 1; r.iterations <= max_iterations; ++r.iterations)
 	{
 		const Similarity2D candidate = fitSimilarity(ref, other, pairs, t.count);
-		auto candidate_pairs = backwardPairs(ref, other_tree, candidate);
-		const Trimming ct = trim(candidate_pairs, p);
+		Trimmed next = trimmedPairs(ref, other_tree, candidate, p);
 		// The re-fit and re-association can only lower ψ in exact arithmetic;
 		// a rise is rounding noise, and keeping the previous transform keeps
 		// the objective monotone.
-		if (!(ct.objective <= t.objective)) { r.converged = true; break; }
-		const double gain = t.objective - ct.objective;
+		if (!(next.trimming.objective <= t.objective)) { r.converged = true; break; }
+		const double gain = t.objective - next.trimming.objective;
 		r.transform = candidate;
-		pairs = std::move(candidate_pairs);
-		t = ct;
+		pairs = std::move(next.pairs);
+		t = next.trimming;
 		r.objective_history.push_back(t.objective);
 		if (gain <= p.relative_tolerance * t.objective) { r.converged = true; break; }
 	}
@@ -154,26 +168,26 @@ TsICPResult runTsICP(
 		throw std::invalid_argument("TsICP xi_min must be in (0, 1]");
 
 	if (p.coarse_points <= 0 || ref.size() <= 2 * size_t(p.coarse_points))
-		return iterate(ref, other, other_tree, start, backwardPairs(ref, other_tree, start), p, p.max_iterations);
+		return iterate(ref, other, other_tree, start, trimmedPairs(ref, other_tree, start, p), p, p.max_iterations);
 
 	// Coarse: every k-th reference point.
 	const PointList sample = strided(ref, size_t(p.coarse_points));
 	const TsICPResult coarse =
-		iterate(sample, other, other_tree, start, backwardPairs(sample, other_tree, start), p, p.max_iterations);
+		iterate(sample, other, other_tree, start, trimmedPairs(sample, other_tree, start, p), p, p.max_iterations);
 	// Fine: on all points, from the coarse result unless (rarely) it is worse
-	// there than the start; the pairs of whichever it starts from are the
-	// fine phase's first.
-	auto start_pairs = backwardPairs(ref, other_tree, start);
-	const double at_start = trim(start_pairs, p).objective;
+	// there than the start; the trimmed pairs of whichever it starts from are
+	// the fine phase's first.
+	Trimmed fine_start = trimmedPairs(ref, other_tree, start, p);
+	const double at_start = fine_start.trimming.objective;
 	bool better = false;
 	if (coarse.transform.isFinite())
 	{
-		auto coarse_pairs = backwardPairs(ref, other_tree, coarse.transform);
-		better = trim(coarse_pairs, p).objective <= at_start;
-		if (better) start_pairs = std::move(coarse_pairs);
+		Trimmed at_coarse = trimmedPairs(ref, other_tree, coarse.transform, p);
+		better = at_coarse.trimming.objective <= at_start;
+		if (better) fine_start = std::move(at_coarse);
 	}
 	TsICPResult r = iterate(
-		ref, other, other_tree, better ? coarse.transform : start, std::move(start_pairs), p,
+		ref, other, other_tree, better ? coarse.transform : start, std::move(fine_start), p,
 		std::max(1, p.max_iterations - (better ? coarse.iterations : 0)));
 	if (better) r.objective_history.insert(r.objective_history.begin(), at_start);
 	r.iterations += coarse.iterations;
