@@ -30,6 +30,35 @@ float occupancyAtCell(const COccupancyGridMap2D& g, const Eigen::Vector2d& p)
 	return occupancyProbability(g, cx, cy);
 }
 
+// The output columns [first, last) of row `row` where any sub-sample can land
+// in an input grid of in_w × in_h cells, `from_out` taking output cell
+// coordinates to the input's (a few columns of slack each side). Elsewhere
+// every sample falls outside the grid, which leaves the cell as the other
+// maps say (fuseCell(p, 0.5) = p for every p the rule makes).
+std::pair<int, int> columnsOverGrid(
+	const Eigen::Matrix2d& from_out, const Eigen::Vector2d& shift, int row, int in_w, int in_h, int out_w)
+{
+	double lo = -INFINITY, hi = INFINITY;
+	for (int d = 0; d < 2; ++d)
+	{
+		const double limit = d == 0 ? in_w : in_h, a = from_out(d, 0);
+		const double b0 = from_out(d, 1) * row + shift(d), b1 = from_out(d, 1) * (row + 1) + shift(d);
+		const double b_min = std::min(b0, b1), b_max = std::max(b0, b1);
+		if (std::abs(a) < 1e-12)  // the row runs along this input axis (a cell of slack for rounding)
+		{
+			if (b_max < -1 || b_min >= limit + 1) return {0, 0};
+			continue;
+		}
+		const double ends[] = {-b_min / a, -b_max / a, (limit - b_min) / a, (limit - b_max) / a};
+		lo = std::max(lo, *std::min_element(std::begin(ends), std::end(ends)) - 1);
+		hi = std::min(hi, *std::max_element(std::begin(ends), std::end(ends)) + 1);
+	}
+	if (!(lo < hi)) return {0, 0};
+	const int first = static_cast<int>(std::clamp(std::floor(lo) - 1, 0.0, double(out_w)));
+	const int last = static_cast<int>(std::clamp(std::ceil(hi) + 1, 0.0, double(out_w)));
+	return {first, std::max(first, last)};
+}
+
 // Sub-samples per output cell axis so that every input cell is hit. A map
 // placed at an estimated scale of 0.999 would need 2 x 2 samples to hit the
 // one cell in a thousand that slips between output cells: that 2 % of slack
@@ -130,18 +159,28 @@ Fused fuseAll(const std::vector<Placed>& in, double res, size_t max_cells)
 	};
 #pragma omp parallel for schedule(dynamic, 16)
 	for (int cy = 0; cy < H; ++cy)
+	{
+		std::vector<std::pair<int, int>> columns(in.size());
+		for (size_t m = 0; m < in.size(); ++m)
+		{
+			if (cy < touched[m].y || cy >= touched[m].y + touched[m].height) continue;
+			const auto [first, last] =
+				columnsOverGrid(linear[m], shift[m], cy, int(in[m].grid->getSizeX()), int(in[m].grid->getSizeY()), W);
+			columns[m] = {std::max(first, touched[m].x), std::min(last, touched[m].x + touched[m].width)};
+		}
 		for (int cx = 0; cx < W; ++cx)
 		{
 			float p = 0.5f;
 			for (size_t m = 0; m < in.size(); ++m)
 			{
-				if (!touched[m].contains(cv::Point(cx, cy))) continue;
+				if (cx < columns[m].first || cx >= columns[m].second) continue;
 				const float pm = reduce(cx, cy, m);
 				fused.classes[m].at<uint8_t>(cy, cx) = classify(pm);
 				p = fuseCell(p, pm);
 			}
 			out.setCell(cx, cy, 1.0f - p);  // MRPT stores P(free)
 		}
+	}
 	return fused;
 }
 }  // namespace
