@@ -2,6 +2,7 @@
 #include <multires_map_merge/GridMapFusion.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -20,15 +21,33 @@ float fuseCell(float a, float b)
 
 namespace
 {
-// Occupancy probability of the cell containing point p (in cell units, cell
-// (0, 0) spanning [0, 1)²), or 0.5 outside.
-float occupancyAtCell(const COccupancyGridMap2D& g, const Eigen::Vector2d& p)
+// Occupancy probabilities of a grid's cells, read through a table over its
+// 8-bit cells: the values of occupancyProbability() without a call into
+// MRPT's log-odds table for each of the fusion's samples.
+class OccupancyReader
 {
-	const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
-	if (cx < 0 || cy < 0 || cx >= static_cast<int>(g.getSizeX()) || cy >= static_cast<int>(g.getSizeY()))
-		return 0.5f;
-	return occupancyProbability(g, cx, cy);
-}
+   public:
+	explicit OccupancyReader(const COccupancyGridMap2D& g)
+		: grid_(&g), w_(static_cast<int>(g.getSizeX())), h_(static_cast<int>(g.getSizeY()))
+	{
+		static_assert(sizeof(COccupancyGridMap2D::cellType) == 1, "the table covers 8-bit cells");
+		for (int v = 0; v < 256; ++v)
+			probability_[v] = 1.0f - COccupancyGridMap2D::l2p(static_cast<COccupancyGridMap2D::cellType>(v));
+	}
+	// The cell containing point p (in cell units, cell (0, 0) spanning
+	// [0, 1)²), or 0.5 outside.
+	float at(const Eigen::Vector2d& p) const
+	{
+		const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
+		if (cx < 0 || cy < 0 || cx >= w_ || cy >= h_) return 0.5f;
+		return probability_[static_cast<uint8_t>(grid_->getRow(cy)[cx])];
+	}
+
+   private:
+	const COccupancyGridMap2D* grid_;
+	int w_, h_;
+	std::array<float, 256> probability_;
+};
 
 // The output columns [first, last) of row `row` where any sub-sample can land
 // in an input grid of in_w × in_h cells, `from_out` taking output cell
@@ -84,6 +103,76 @@ struct Fused
 	std::vector<cv::Mat> classes;  //!< per input
 };
 
+/** The metric box of the union of the inputs' extents in the output frame. */
+struct Box
+{
+	double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+	void add(const COccupancyGridMap2D& g, const Similarity2D& to_out)
+	{
+		for (double x : {g.getXMin(), g.getXMax()})
+			for (double y : {g.getYMin(), g.getYMax()})
+			{
+				const Eigen::Vector2d c = to_out(Eigen::Vector2d(x, y));
+				x0 = std::min(x0, c.x()), x1 = std::max(x1, c.x());
+				y0 = std::min(y0, c.y()), y1 = std::max(y1, c.y());
+			}
+	}
+};
+
+/** One input as the output's cells see it: output cell coordinates → its
+ * cell units (one affine map, no sine, cosine or division per sample), the
+ * output cells it can touch and its sub-samples per output cell. */
+class InputSampler
+{
+   public:
+	InputSampler(const Placed& m, const COccupancyGridMap2D& out, double res) : read_(*m.grid)
+	{
+		const double in_res = m.grid->getResolution();
+		const Eigen::Vector2d out_corner(out.getXMin(), out.getYMin());
+		const Similarity2D from_out = m.to_out.inverse();
+		linear_ = from_out.linear() * (res / in_res);
+		shift_ = (from_out.linear() * out_corner + from_out.t - Eigen::Vector2d(m.grid->getXMin(), m.grid->getYMin())) / in_res;
+		Box b;
+		b.add(*m.grid, m.to_out);
+		const int W = static_cast<int>(out.getSizeX()), H = static_cast<int>(out.getSizeY());
+		const int cx0 = std::max(0, int(std::floor((b.x0 - out_corner.x()) / res)) - 1);
+		const int cy0 = std::max(0, int(std::floor((b.y0 - out_corner.y()) / res)) - 1);
+		const int cx1 = std::min(W, int(std::ceil((b.x1 - out_corner.x()) / res)) + 1);
+		const int cy1 = std::min(H, int(std::ceil((b.y1 - out_corner.y()) / res)) + 1);
+		touched_ = cv::Rect(cx0, cy0, std::max(0, cx1 - cx0), std::max(0, cy1 - cy0));
+		k_ = samplesPerAxis(res, in_res * m.to_out.scale);
+		in_w_ = static_cast<int>(m.grid->getSizeX()), in_h_ = static_cast<int>(m.grid->getSizeY()), out_w_ = W;
+	}
+
+	/** The output columns [first, last) of row `cy` this input can change. */
+	std::pair<int, int> columns(int cy) const
+	{
+		if (cy < touched_.y || cy >= touched_.y + touched_.height) return {0, 0};
+		const auto [first, last] = columnsOverGrid(linear_, shift_, cy, in_w_, in_h_, out_w_);
+		return {std::max(first, touched_.x), std::min(last, touched_.x + touched_.width)};
+	}
+
+	/** The input over output cell (cx, cy): its sub-samples reduced with the cell rule. */
+	float at(int cx, int cy) const
+	{
+		float p = 0.5f;
+		for (int i = 0; i < k_; ++i)
+			for (int j = 0; j < k_; ++j)
+			{
+				const Eigen::Vector2d c(cx + (i + 0.5) / k_, cy + (j + 0.5) / k_);
+				p = fuseCell(p, read_.at(linear_ * c + shift_));
+			}
+		return p;
+	}
+
+   private:
+	OccupancyReader read_;
+	Eigen::Matrix2d linear_;
+	Eigen::Vector2d shift_;
+	cv::Rect touched_;
+	int k_ = 1, in_w_ = 0, in_h_ = 0, out_w_ = 0;
+};
+
 /** The cell rule over any number of placed grids, on the union of their
  * extents, in one pass over the output (fusing pairwise into a growing result
  * would resample the result once per map). */
@@ -95,16 +184,9 @@ Fused fuseAll(const std::vector<Placed>& in, double res, size_t max_cells)
 		if (!m.to_out.isFinite() || !(m.to_out.scale > 0))
 			throw std::invalid_argument("fusion needs a finite transform with positive scale");
 
-	double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-	for (const auto& m : in)
-		for (double x : {m.grid->getXMin(), m.grid->getXMax()})
-			for (double y : {m.grid->getYMin(), m.grid->getYMax()})
-			{
-				const Eigen::Vector2d c = m.to_out(Eigen::Vector2d(x, y));
-				x0 = std::min(x0, c.x()), x1 = std::max(x1, c.x());
-				y0 = std::min(y0, c.y()), y1 = std::max(y1, c.y());
-			}
-	const double w = std::ceil((x1 - x0) / res), h = std::ceil((y1 - y0) / res);
+	Box box;
+	for (const auto& m : in) box.add(*m.grid, m.to_out);
+	const double w = std::ceil((box.x1 - box.x0) / res), h = std::ceil((box.y1 - box.y0) / res);
 	if (w * h > static_cast<double>(max_cells))
 		throw MergedMapTooLarge(
 			"merged map would have " + std::to_string(static_cast<long long>(w * h)) +
@@ -113,73 +195,45 @@ Fused fuseAll(const std::vector<Placed>& in, double res, size_t max_cells)
 	Fused fused;
 	COccupancyGridMap2D& out = fused.grid;
 	out.setSize(
-		static_cast<float>(x0), static_cast<float>(x0 + w * res), static_cast<float>(y0),
-		static_cast<float>(y0 + h * res), static_cast<float>(res), 0.5f);
-	const double ox = out.getXMin(), oy = out.getYMin();
+		static_cast<float>(box.x0), static_cast<float>(box.x0 + w * res), static_cast<float>(box.y0),
+		static_cast<float>(box.y0 + h * res), static_cast<float>(res), 0.5f);
 	const int W = static_cast<int>(out.getSizeX()), H = static_cast<int>(out.getSizeY());
-	// Per input: output cell coordinates → its cell units (one affine map, no
-	// sine, cosine or division per sample), and the output cells it can touch.
-	std::vector<Eigen::Matrix2d> linear;
-	std::vector<Eigen::Vector2d> shift;
-	std::vector<cv::Rect> touched;
-	std::vector<int> k;
+	std::vector<InputSampler> samplers;
 	for (const auto& m : in)
 	{
-		const Similarity2D from_out = m.to_out.inverse();
-		const double in_res = m.grid->getResolution();
-		linear.push_back(from_out.linear() * (res / in_res));
-		shift.push_back((from_out.linear() * Eigen::Vector2d(ox, oy) + from_out.t -
-						 Eigen::Vector2d(m.grid->getXMin(), m.grid->getYMin())) / in_res);
-		double bx0 = INFINITY, bx1 = -INFINITY, by0 = INFINITY, by1 = -INFINITY;
-		for (double x : {m.grid->getXMin(), m.grid->getXMax()})
-			for (double y : {m.grid->getYMin(), m.grid->getYMax()})
-			{
-				const Eigen::Vector2d c = m.to_out(Eigen::Vector2d(x, y));
-				bx0 = std::min(bx0, c.x()), bx1 = std::max(bx1, c.x());
-				by0 = std::min(by0, c.y()), by1 = std::max(by1, c.y());
-			}
-		const int cx0 = std::max(0, int(std::floor((bx0 - ox) / res)) - 1), cy0 = std::max(0, int(std::floor((by0 - oy) / res)) - 1);
-		const int cx1 = std::min(W, int(std::ceil((bx1 - ox) / res)) + 1), cy1 = std::min(H, int(std::ceil((by1 - oy) / res)) + 1);
-		touched.emplace_back(cx0, cy0, std::max(0, cx1 - cx0), std::max(0, cy1 - cy0));
-		k.push_back(samplesPerAxis(res, in_res * m.to_out.scale));
+		samplers.emplace_back(m, out, res);
 		fused.classes.emplace_back(H, W, CV_8UC1, cv::Scalar(kUnknown));
 	}
 
-	// Each input is first reduced over its sub-samples with the same rule,
-	// then the inputs are combined.
-	auto reduce = [&](int cx, int cy, size_t m) {
-		float p = 0.5f;
-		for (int i = 0; i < k[m]; ++i)
-			for (int j = 0; j < k[m]; ++j)
-			{
-				const Eigen::Vector2d c(cx + (i + 0.5) / k[m], cy + (j + 0.5) / k[m]);
-				p = fuseCell(p, occupancyAtCell(*in[m].grid, linear[m] * c + shift[m]));
-			}
-		return p;
-	};
-#pragma omp parallel for schedule(dynamic, 16)
-	for (int cy = 0; cy < H; ++cy)
+	// The output is fused in bands of rows, one input at a time over a band:
+	// an input turned against the output is read across its rows, and the
+	// band uses the cache lines of its columns again before another input's
+	// evict them. Each cell still combines the inputs in their order (each
+	// input first reduced over its sub-samples), so the order of the passes
+	// does not change the result.
+	constexpr int kBandRows = 32;
+	const int bands = (H + kBandRows - 1) / kBandRows;
+#pragma omp parallel for schedule(dynamic, 1)
+	for (int band = 0; band < bands; ++band)
 	{
-		std::vector<std::pair<int, int>> columns(in.size());
+		const int row0 = band * kBandRows, rows = std::min(kBandRows, H - row0);
+		std::vector<float> p(static_cast<size_t>(rows) * W, 0.5f);
 		for (size_t m = 0; m < in.size(); ++m)
-		{
-			if (cy < touched[m].y || cy >= touched[m].y + touched[m].height) continue;
-			const auto [first, last] =
-				columnsOverGrid(linear[m], shift[m], cy, int(in[m].grid->getSizeX()), int(in[m].grid->getSizeY()), W);
-			columns[m] = {std::max(first, touched[m].x), std::min(last, touched[m].x + touched[m].width)};
-		}
-		for (int cx = 0; cx < W; ++cx)
-		{
-			float p = 0.5f;
-			for (size_t m = 0; m < in.size(); ++m)
+			for (int cy = row0; cy < row0 + rows; ++cy)
 			{
-				if (cx < columns[m].first || cx >= columns[m].second) continue;
-				const float pm = reduce(cx, cy, m);
-				fused.classes[m].at<uint8_t>(cy, cx) = classify(pm);
-				p = fuseCell(p, pm);
+				const auto [first, last] = samplers[m].columns(cy);
+				float* p_row = &p[static_cast<size_t>(cy - row0) * W];
+				uint8_t* class_row = fused.classes[m].ptr<uint8_t>(cy);
+				for (int cx = first; cx < last; ++cx)
+				{
+					const float pm = samplers[m].at(cx, cy);
+					class_row[cx] = classify(pm);
+					p_row[cx] = fuseCell(p_row[cx], pm);
+				}
 			}
-			out.setCell(cx, cy, 1.0f - p);  // MRPT stores P(free)
-		}
+		for (int cy = row0; cy < row0 + rows; ++cy)
+			for (int cx = 0; cx < W; ++cx)
+				out.setCell(cx, cy, 1.0f - p[static_cast<size_t>(cy - row0) * W + cx]);  // MRPT stores P(free)
 	}
 	return fused;
 }
