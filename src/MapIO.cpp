@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -237,25 +238,29 @@ GridInFrame loadMapServerYaml(const std::string& path)
 	// map_server averages alpha in with the colour in trinary mode only.
 	const int averaged = (has_alpha && y.mode != MapServerMode::trinary) ? channels - 1 : channels;
 
-	auto colourAt = [&](const uint8_t* px) {
+	// A pixel's reading depends only on its channel sum and whether it is
+	// opaque: read through tables over those, each value worked out once.
+	auto channelSum = [&](const uint8_t* px) {
 		int sum = 0;
 		for (int k = 0; k < averaged; ++k) sum += px[k];
-		return double(sum) / averaged;
+		return sum;
 	};
 	auto opaqueAt = [&](const uint8_t* px) { return !has_alpha || px[channels - 1] > 0; };
+	const int sums = 255 * averaged + 1;
 	// The unknown grey: the commonest in-between colour (trinary mode).
 	std::optional<double> faint_wall_above;  // occupancy
 	if (y.mode == MapServerMode::trinary)
 	{
+		std::vector<int> in_between_bin(sums, -1);  // by channel sum, for an opaque pixel
+		for (int sum = 0; sum < sums; ++sum)
+			if (const double colour = double(sum) / averaged; mapServerValue(colour, true, y) < 0)
+				in_between_bin[sum] = static_cast<int>(std::lround(colour));
 		std::array<size_t, 256> in_between{};
 		for (int row = 0; row < img.rows; ++row)
 		{
 			const uint8_t* px = img.ptr<uint8_t>(row);
 			for (int cx = 0; cx < img.cols; ++cx, px += channels)
-			{
-				const double colour = colourAt(px);
-				if (opaqueAt(px) && mapServerValue(colour, true, y) < 0) ++in_between[size_t(std::lround(colour))];
-			}
+				if (const int bin = in_between_bin[channelSum(px)]; bin >= 0 && opaqueAt(px)) ++in_between[bin];
 		}
 		const auto commonest = std::max_element(in_between.begin(), in_between.end());
 		const size_t all_in_between = std::accumulate(in_between.begin(), in_between.end(), size_t(0));
@@ -265,6 +270,25 @@ GridInFrame loadMapServerYaml(const std::string& path)
 			faint_wall_above = pixelOccupancy(grey, y) + kFaintWallMargin;
 		}
 	}
+	auto occupancyOf = [&](double colour, bool opaque) {
+		const int v = mapServerValue(colour, opaque, y);
+		float occupancy = v < 0 ? 0.5f : v / 100.0f;
+		if (v < 0 && faint_wall_above && opaque)
+		{
+			// Between the unknown grey's occupancy and occupied_thresh
+			// onto (0.5, 1]: a wall (kOccupiedAbove), as sure as it is dark.
+			const double occ = pixelOccupancy(colour, y);
+			const double unknown = *faint_wall_above - kFaintWallMargin;
+			if (occ > *faint_wall_above && y.occupied_thresh > unknown)
+				occupancy = float(std::min(1.0, 0.5 + 0.5 * (occ - unknown) / (y.occupied_thresh - unknown)));
+		}
+		return occupancy;
+	};
+	using Cell = COccupancyGridMap2D::cellType;
+	std::array<std::vector<Cell>, 2> cell_of;  // [opaque][channel sum]; MRPT stores P(free)
+	for (int opaque : {0, 1})
+		for (int sum = 0; sum < sums; ++sum)
+			cell_of[opaque].push_back(COccupancyGridMap2D::p2l(1.0f - occupancyOf(double(sum) / averaged, opaque)));
 
 	GridInFrame map;
 	map.origin = Similarity2D(1, y.origin[2], {y.origin[0], y.origin[1]});
@@ -277,23 +301,8 @@ GridInFrame loadMapServerYaml(const std::string& path)
 	for (int row = 0; row < img.rows; ++row)
 	{
 		const uint8_t* px = img.ptr<uint8_t>(row);
-		const int cy = img.rows - 1 - row;  // image rows run top-down, grid rows bottom-up
-		for (int cx = 0; cx < img.cols; ++cx, px += channels)
-		{
-			const double colour = colourAt(px);
-			const int v = mapServerValue(colour, opaqueAt(px), y);
-			float occupancy = v < 0 ? 0.5f : v / 100.0f;
-			if (v < 0 && faint_wall_above && opaqueAt(px))
-			{
-				// Between the unknown grey's occupancy and occupied_thresh
-				// onto (0.5, 1]: a wall (kOccupiedAbove), as sure as it is dark.
-				const double occ = pixelOccupancy(colour, y);
-				const double unknown = *faint_wall_above - kFaintWallMargin;
-				if (occ > *faint_wall_above && y.occupied_thresh > unknown)
-					occupancy = float(std::min(1.0, 0.5 + 0.5 * (occ - unknown) / (y.occupied_thresh - unknown)));
-			}
-			g.setCell(cx, cy, 1.0f - occupancy);  // MRPT stores P(free)
-		}
+		Cell* cells = g.getRow(img.rows - 1 - row);  // image rows run top-down, grid rows bottom-up
+		for (int cx = 0; cx < img.cols; ++cx, px += channels) cells[cx] = cell_of[opaqueAt(px)][channelSum(px)];
 	}
 	return map;
 }
@@ -325,6 +334,27 @@ GridInFrame loadGridMap(const std::string& path, double simplemap_resolution)
 		fail(path, "unknown map format (expected .gridmap[.gz], .yaml or .simplemap[.gz])");
 	checkLoaded(map.grid, path);
 	return map;
+}
+
+std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, double simplemap_resolution)
+{
+	std::vector<GridInFrame> maps(paths.size());
+	std::vector<std::exception_ptr> errors(paths.size());
+#pragma omp parallel for schedule(dynamic, 1)
+	for (size_t i = 0; i < paths.size(); ++i)
+	{
+		try
+		{
+			maps[i] = loadGridMap(paths[i], simplemap_resolution);
+		}
+		catch (...)
+		{
+			errors[i] = std::current_exception();  // an exception may not leave the parallel loop
+		}
+	}
+	for (const auto& e : errors)
+		if (e) std::rethrow_exception(e);
+	return maps;
 }
 
 std::string saveGridMap(const GridInFrame& map, const std::string& path)

@@ -8,6 +8,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace multires_map_merge
 {
@@ -27,6 +28,10 @@ struct MapIOError : std::runtime_error
  * - `.simplemap` / `.simplemap.gz`: rendered at `simplemap_resolution` metres.
  * Rejects empty maps, non-finite metadata and files it cannot read. */
 GridInFrame loadGridMap(const std::string& path, double simplemap_resolution = 0.05);
+
+/** loadGridMap of each path, the files read in parallel; the error of the
+ * first path (in their order) that fails is thrown. */
+std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, double simplemap_resolution = 0.05);
 
 /** Saves .gridmap.gz / .gridmap, or map_server .yaml plus a .pgm beside it
  * (occupied 0, free 254, unknown 205; trinary; origin = the corner of cell

@@ -62,9 +62,7 @@ struct Inputs
 
 Inputs fromFiles(const std::vector<std::string>& files, double simplemap_res)
 {
-	Inputs in;
-	for (const auto& f : files) in.maps.push_back(loadGridMap(f, simplemap_res)), in.names.push_back(f);
-	return in;
+	return {loadGridMaps(files, simplemap_res), files};
 }
 
 Inputs fromBag(const std::string& bag, const std::vector<std::string>& topics)
