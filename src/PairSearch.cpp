@@ -432,7 +432,7 @@ void refineFeatureHypotheses(const PairContext& c, SearchState& state)
 void refineStructureHypotheses(const PairContext& c, SearchState& state)
 {
 	mrpt::system::CTicTac clock;
-	const auto hyps = structureHypotheses(c.ref.classes, c.other.classes, {}, c.expected_scale);
+	const auto hyps = structureHypotheses(c.ref.walls(), c.other.walls(), {}, c.expected_scale);
 	state.stage_seconds["structure"] = clock.Tac();
 	state.hypotheses += hyps.size();
 	refineAll(c, state, hyps);

@@ -1,6 +1,7 @@
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/PreparedMap.h>
+#include <multires_map_merge/StructureHypotheses.h>
 
 #include <mrpt/system/CTicTac.h>
 
@@ -48,9 +49,12 @@ void describeMap(PreparedMap& p)
 
 PreparedMapPtr PreparedMap::mirrored() const
 {
-	const auto& once = mirror_cache.once;
-	std::call_once(once->flag, [&] { once->map = mirroredMap(*this); });
-	return once->map;
+	return mirror_cache.get([this] { return mirroredMap(*this); });
+}
+
+const MapWalls& PreparedMap::walls() const
+{
+	return *walls_cache.get([this] { return std::make_shared<const MapWalls>(classes); });
 }
 
 PreparedMapPtr mirroredMap(const PreparedMap& map)

@@ -66,10 +66,29 @@ double dominantWallDirection(const cv::Mat& classes)
 	return d;
 }
 
+double MapWalls::dominantDirection() const
+{
+	std::call_once(direction_once_, [this] { direction_ = dominantWallDirection(classes_); });
+	return direction_;
+}
+
+cv::Mat MapWalls::at(double f) const
+{
+	{
+		std::lock_guard<std::mutex> lock(mutex_);
+		if (auto it = walls_.find(f); it != walls_.end()) return it->second;
+	}
+	// Made outside the lock (the threads would wait on each other); the first one made kept.
+	cv::Mat made = wallImage(classes_ == kOccupied, f);
+	std::lock_guard<std::mutex> lock(mutex_);
+	return walls_.emplace(f, std::move(made)).first->second;
+}
+
 namespace
 {
 /** The reference's walls at the sizes the poses need (the other map is
- * never enlarged: the reference shrinks instead), each within its bounding
+ * never enlarged: the reference shrinks instead; MapWalls keeps the images
+ * for the reference's next pair), each within its bounding
  * box (the rest of a map is often unexplored margin: the correlation is the
  * same, its DFTs smaller), with their spectra per canvas. Shared by the
  * pose threads: made outside the lock (the threads would wait on each
@@ -85,9 +104,9 @@ class RefViews
 		bool has_walls = false;  //!< any wall left at this size
 	};
 
-	RefViews(const cv::Mat& ref_occupied, double f_ref, const cv::Mat& walls_at_f_ref) : ref_occupied_(ref_occupied)
+	RefViews(const MapWalls& ref, double f_ref) : ref_(ref)
 	{
-		views_.emplace(f_ref, Entry{makeView(f_ref, walls_at_f_ref), {}});
+		views_.emplace(f_ref, Entry{makeView(f_ref, ref.at(f_ref)), {}});
 	}
 
 	const View& at(double f)
@@ -96,7 +115,7 @@ class RefViews
 			std::lock_guard<std::mutex> lock(mutex_);
 			if (auto it = views_.find(f); it != views_.end()) return it->second.view;
 		}
-		View made = makeView(f, wallImage(ref_occupied_, f));
+		View made = makeView(f, ref_.at(f));
 		std::lock_guard<std::mutex> lock(mutex_);
 		return views_.emplace(f, Entry{std::move(made), {}}).first->second.view;
 	}
@@ -141,7 +160,7 @@ class RefViews
 		return v;
 	}
 
-	const cv::Mat& ref_occupied_;
+	const MapWalls& ref_;
 	std::map<double, Entry> views_;  // by factor
 	std::mutex mutex_;
 };
@@ -284,15 +303,15 @@ std::vector<Scored> searchPose(const PoseSearch& ps, double s, double yaw)
  * right-angle turn), with both maps at most `working_size` across; empty
  * where a pose was skipped. */
 std::vector<std::vector<Scored>> searchPoses(
-	const cv::Mat& ref_occupied, const cv::Mat& other_occupied, int working_size, const std::vector<double>& scales,
-	double turn, int peaks)
+	const MapWalls& ref, const MapWalls& other, int working_size, const std::vector<double>& scales, double turn,
+	int peaks)
 {
 	std::vector<std::vector<Scored>> found_per_pose(scales.size() * 4);
-	const double f_ref = fitFactor(ref_occupied, working_size);
-	const double f_other = fitFactor(other_occupied, working_size);
-	const cv::Mat a = wallImage(ref_occupied, f_ref), b0 = wallImage(other_occupied, f_other);
+	const double f_ref = fitFactor(ref.classes(), working_size);
+	const double f_other = fitFactor(other.classes(), working_size);
+	const cv::Mat a = ref.at(f_ref), b0 = other.at(f_other);
 	if (cv::sum(a)[0] <= 0 || cv::sum(b0.mul(b0))[0] <= 0) return found_per_pose;
-	RefViews views(ref_occupied, f_ref, a);
+	RefViews views(ref, f_ref);
 	const PoseSearch ps{b0, f_ref, f_other, working_size, peaks, views};
 	// The poses are independent: searched in parallel, each keeping its own
 	// peaks, gathered in pose order so the result does not depend on the threads.
@@ -308,8 +327,14 @@ std::vector<Hypothesis> structureHypotheses(
 	const cv::Mat& ref_classes, const cv::Mat& other_classes, const StructureParams& p,
 	std::optional<double> expected_scale)
 {
+	return structureHypotheses(MapWalls(ref_classes), MapWalls(other_classes), p, expected_scale);
+}
+
+std::vector<Hypothesis> structureHypotheses(
+	const MapWalls& ref, const MapWalls& other, const StructureParams& p, std::optional<double> expected_scale)
+{
 	std::vector<Hypothesis> out;
-	if (ref_classes.empty() || other_classes.empty()) return out;
+	if (ref.classes().empty() || other.classes().empty()) return out;
 	std::vector<double> scales;  // other full cells → ref full cells
 	if (expected_scale)
 		scales = {*expected_scale};
@@ -318,11 +343,9 @@ std::vector<Hypothesis> structureHypotheses(
 			 std::pow(2.0, double(k) / p.steps_per_octave) <= p.max_scale * 1.0001; ++k)
 			if (std::pow(2.0, double(k) / p.steps_per_octave) >= p.min_scale * 0.9999)
 				scales.push_back(std::pow(2.0, double(k) / p.steps_per_octave));
-	const double turn = dominantWallDirection(ref_classes) - dominantWallDirection(other_classes);
-	const cv::Mat ref_occupied = ref_classes == kOccupied, other_occupied = other_classes == kOccupied;
-	const auto found_per_pose =
-		searchPoses(ref_occupied, other_occupied, p.working_size, scales, turn, p.peaks_per_pose);
-	const double f_ref = fitFactor(ref_classes, p.working_size);
+	const double turn = ref.dominantDirection() - other.dominantDirection();
+	const auto found_per_pose = searchPoses(ref, other, p.working_size, scales, turn, p.peaks_per_pose);
+	const double f_ref = fitFactor(ref.classes(), p.working_size);
 	std::vector<Scored> found;
 	for (const auto& f : found_per_pose) found.insert(found.end(), f.begin(), f.end());
 	std::sort(found.begin(), found.end(), [](const Scored& x, const Scored& y) { return x.score > y.score; });

@@ -21,6 +21,38 @@
 
 namespace multires_map_merge
 {
+class MapWalls;  // StructureHypotheses.h
+
+/** A value made from a map when first asked and kept with it, by whichever
+ * thread asks first. A copy of the map starts without one: it may be
+ * changed before it is asked. */
+template <class T>
+class OnceCache
+{
+   public:
+	OnceCache() = default;
+	OnceCache(const OnceCache&) {}
+	OnceCache& operator=(const OnceCache&)
+	{
+		once_ = std::make_shared<Once>();
+		return *this;
+	}
+	template <class Make>
+	const std::shared_ptr<const T>& get(Make make) const
+	{
+		std::call_once(once_->flag, [&] { once_->value = make(); });
+		return once_->value;
+	}
+
+   private:
+	struct Once
+	{
+		std::once_flag flag;
+		std::shared_ptr<const T> value;
+	};
+	std::shared_ptr<Once> once_ = std::make_shared<Once>();  // a once_flag cannot be copied or moved
+};
+
 struct PreparedMap
 {
 	/** Why this map cannot be aligned, after "reference map " or "other
@@ -47,25 +79,12 @@ struct PreparedMap
 	 * fleet's reference meets it in every pair. Safe to call from several
 	 * threads. */
 	std::shared_ptr<const PreparedMap> mirrored() const;
-	/** mirrored()'s, made once by whichever thread asks first. A copy of
-	 * the map starts without one: it may be changed before it is mirrored. */
-	struct MirrorCache
-	{
-		struct Once
-		{
-			std::once_flag flag;
-			std::shared_ptr<const PreparedMap> map;
-		};
-		std::shared_ptr<Once> once = std::make_shared<Once>();
-		MirrorCache() = default;
-		MirrorCache(const MirrorCache&) {}
-		MirrorCache& operator=(const MirrorCache&)
-		{
-			once = std::make_shared<Once>();
-			return *this;
-		}
-	};
-	MirrorCache mirror_cache;
+	/** Its walls as the structure search reads them (MapWalls), made when
+	 * first asked and kept with it: a fleet's reference meets the same wall
+	 * images in every pair. Safe to call from several threads. */
+	const MapWalls& walls() const;
+	OnceCache<PreparedMap> mirror_cache;
+	OnceCache<MapWalls> walls_cache;
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
 

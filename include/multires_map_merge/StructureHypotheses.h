@@ -11,6 +11,9 @@
 #include <multires_map_merge/FeatureHypotheses.h>
 
 #include <opencv2/core.hpp>
+
+#include <map>
+#include <mutex>
 #include <optional>
 #include <vector>
 
@@ -26,9 +29,37 @@ struct StructureParams
 	int max_hypotheses = 8;
 };
 
+/** A map's walls as the structure search reads them, each made when first
+ * asked and kept: its dominant wall direction and its wall images at the
+ * sizes asked for (a fleet's reference meets the same sizes in every pair).
+ * Safe to share between threads; the images returned are not to be written. */
+class MapWalls
+{
+   public:
+	explicit MapWalls(cv::Mat classes) : classes_(std::move(classes)) {}
+	const cv::Mat& classes() const { return classes_; }
+	/** dominantWallDirection of the classes. */
+	double dominantDirection() const;
+	/** The walls at `f` (≤ 1) times the map's size as 0/1 floats, a cell a
+	 * wall where any wall cell lies under it (as resampleClasses keeps
+	 * walls), blurred by a cell. */
+	cv::Mat at(double f) const;
+
+   private:
+	cv::Mat classes_;
+	mutable std::once_flag direction_once_;
+	mutable double direction_ = 0;
+	mutable std::mutex mutex_;
+	mutable std::map<double, cv::Mat> walls_;  // by factor
+};
+
 /** Similarity hypotheses other → ref (full-resolution cell coordinates),
  * best correlation first. With `expected_scale` only that scale is tried
  * (TsICP refines it). */
+std::vector<Hypothesis> structureHypotheses(
+	const MapWalls& ref, const MapWalls& other, const StructureParams& p = {},
+	std::optional<double> expected_scale = std::nullopt);
+/** The same on two class images (their walls made for this call alone). */
 std::vector<Hypothesis> structureHypotheses(
 	const cv::Mat& ref_classes, const cv::Mat& other_classes, const StructureParams& p = {},
 	std::optional<double> expected_scale = std::nullopt);
