@@ -254,6 +254,54 @@ TwoWaySupport twoWaySupport(
 	return s;
 }
 
+namespace
+{
+/** Per shift (offsets[ky] rows, offsets[kx] columns; index ky × n + kx):
+ * the sum of `worth` where the points land shifted, and whether any lands
+ * on a judged cell. */
+struct ShiftScores
+{
+	std::vector<long> value;
+	std::vector<uint8_t> judged;
+};
+ShiftScores scoreShifts(
+	const std::vector<ptrdiff_t>& unshifted, const std::vector<int8_t>& worth, const std::vector<uint8_t>& judged_at,
+	int window_w, const std::vector<int>& offsets)
+{
+	const size_t n = offsets.size();
+	ShiftScores s{std::vector<long>(n * n, 0), std::vector<uint8_t>(n * n, 0)};
+	// Offsets a cell apart (the usual case): a point's shifts along a row
+	// read adjacent window cells, a loop the compiler vectorises. The sums
+	// are of integers: any order gives the same.
+	bool adjacent = true;
+	for (size_t k = 1; k < n; ++k) adjacent &= offsets[k] == offsets[k - 1] + 1;
+	std::vector<int> row_value(n);
+	std::vector<uint8_t> row_judged(n);
+	for (size_t ky = 0; ky < n; ++ky)
+	{
+		std::fill(row_value.begin(), row_value.end(), 0);
+		std::fill(row_judged.begin(), row_judged.end(), 0);
+		const ptrdiff_t row_offset = ptrdiff_t(offsets[ky]) * window_w;
+		for (const ptrdiff_t i : unshifted)
+		{
+			const int8_t* w = &worth[size_t(i + row_offset + offsets[0])];
+			const uint8_t* j = &judged_at[size_t(i + row_offset + offsets[0])];
+			if (adjacent)
+				for (size_t kx = 0; kx < n; ++kx) row_value[kx] += w[kx], row_judged[kx] |= j[kx];
+			else
+				for (size_t kx = 0; kx < n; ++kx)
+				{
+					const int dx = offsets[kx] - offsets[0];
+					row_value[kx] += w[dx], row_judged[kx] |= j[dx];
+				}
+		}
+		std::copy(row_value.begin(), row_value.end(), s.value.begin() + ky * n);
+		std::copy(row_judged.begin(), row_judged.end(), s.judged.begin() + ky * n);
+	}
+	return s;
+}
+}  // namespace
+
 ShiftField shiftField(
 	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target,
 	double tolerance, double tile, double reach, double step)
@@ -280,6 +328,8 @@ ShiftField shiftField(
 	// Fewer points than this fit some shift by chance: the tile says nothing.
 	constexpr size_t kMinTilePoints = 12;
 	const int steps = std::max(0, int(std::floor(reach / step)));
+	std::vector<int> shift_offsets;  // along either axis, in target cells
+	for (int i = -steps; i <= steps; ++i) shift_offsets.push_back(int(std::lround(i * step)));
 	std::map<std::pair<int, int>, cv::Point> best_shift;
 	for (const auto& [key, tile_points] : tiles)
 	{
@@ -310,25 +360,19 @@ ShiftField shiftField(
 		std::vector<ptrdiff_t> unshifted(pts.size());
 		for (size_t k = 0; k < pts.size(); ++k)
 			unshifted[k] = ptrdiff_t(pts[k].y - y0) * window_w + ptrdiff_t(pts[k].x - x0);
+		const ShiftScores scores = scoreShifts(unshifted, worth, judged_at, window_w, shift_offsets);
 		long best_value = std::numeric_limits<long>::min();
 		int best_norm = 0;
 		bool judged = false;
 		cv::Point best(0, 0);
-		for (int iy = -steps; iy <= steps; ++iy)
-			for (int ix = -steps; ix <= steps; ++ix)
+		for (size_t ky = 0; ky < shift_offsets.size(); ++ky)
+			for (size_t kx = 0; kx < shift_offsets.size(); ++kx)
 			{
-				const cv::Point d(int(std::lround(ix * step)), int(std::lround(iy * step)));
-				const ptrdiff_t offset = ptrdiff_t(d.y) * window_w + d.x;
-				long value = 0;
-				unsigned any_judged = 0;
-				for (const ptrdiff_t i : unshifted)
-				{
-					value += worth[size_t(i + offset)];
-					any_judged |= judged_at[size_t(i + offset)];
-				}
-				const bool any = any_judged != 0;
+				const cv::Point d(shift_offsets[kx], shift_offsets[ky]);
+				const size_t k = ky * shift_offsets.size() + kx;
+				const long value = scores.value[k];
 				const int norm = d.x * d.x + d.y * d.y;
-				if (any && (value > best_value || (value == best_value && norm < best_norm)))
+				if (scores.judged[k] && (value > best_value || (value == best_value && norm < best_norm)))
 					best_value = value, best_norm = norm, best = d, judged = true;
 			}
 		if (!judged) continue;
