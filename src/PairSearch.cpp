@@ -182,15 +182,17 @@ Refined screenedOnly(const PairContext& c, const SearchState& state, const Hypot
 	return out;
 }
 
-/** The transform refit to where its regions fit best (bend_refit_iterations),
- * from its judgement's shift field (the first refit's: not computed again). */
+/** The transform refit to where its walls' regions fit best
+ * (bend_refit_iterations); the first refit from its judgement's shift field
+ * where that was on the walls alone (not computed again). */
 Similarity2D bendRefit(const PairContext& c, const Judgement& judged_at, Similarity2D t)
 {
 	for (int i = 0; i < c.options.bend_refit_iterations && t.isFinite() && t.scale > 0; ++i)
 		t = bendBalanced(
-			i == 0 ? judged_at.bends
-				   : twoWayShiftField(
-						 c.ref.edges, c.ref.field, c.other.edges, c.other.field, t, c.options.verify_tolerance),
+			i == 0 && c.judgesWallsAlone()
+				? judged_at.bends
+				: twoWayShiftField(
+					  c.ref.edges, c.ref.field, c.other.edges, c.other.field, t, c.options.verify_tolerance),
 			t);
 	return t;
 }
@@ -339,14 +341,16 @@ PairContext makeContext(
 Judgement judge(const PairContext& c, const Similarity2D& t, size_t most, bool in_full)
 {
 	const auto& o = c.options;
-	const PointList &ref_edges = c.ref.edges, &other_edges = c.other.edges;
 	Judgement j;
 	const TwoWaySupport sup = twoWaySupport(
 		c.refJudged(), c.ref.field, c.otherJudged(), c.other.field, t, o.verify_tolerance, most, in_full);
 	const Chance chance = chanceSupport(
 		c.refJudged(), c.ref.field, c.otherJudged(), c.other.field, t, o.verify_tolerance, o.verify_shift,
 		o.verify_turn_deg, most);
-	j.bends = twoWayShiftField(ref_edges, c.ref.field, other_edges, c.other.field, t, o.verify_tolerance, most);
+	// B on the points T and C judge (a robot map against a plan: its walls
+	// and free sample), so the score's B − C compares like with like.
+	j.bends = twoWayShiftField(
+		c.refJudged(), c.ref.field, c.otherJudged(), c.other.field, t, o.verify_tolerance, most);
 	// The count a full judgement would take, from a sample's.
 	auto full = [&](size_t judged, size_t n) {
 		return double(judged) * double(std::min(n, kJudgedPoints)) / double(std::max<size_t>(1, std::min(n, most)));

@@ -40,6 +40,8 @@ struct PairContext
 	{
 		return other_walls_and_free.empty() ? other.edges : other_walls_and_free;
 	}
+	/** Whether both maps are judged on their walls alone (no floor plan). */
+	bool judgesWallsAlone() const { return ref_walls_and_free.empty() && other_walls_and_free.empty(); }
 	/** A finite transform at a scale allowed (use_resolution_metadata). */
 	bool usable(const Similarity2D& t) const;
 };
