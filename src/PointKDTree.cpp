@@ -47,6 +47,21 @@ std::pair<size_t, double> PointKDTree::nearest(const Eigen::Vector2d& q) const
 	return {static_cast<size_t>(idx), d2};
 }
 
+std::pair<size_t, double> PointKDTree::nearest(const Eigen::Vector2d& q, size_t near) const
+{
+	if (near >= impl_->points.size()) return nearest(q);
+	// Widened a little: nanoflann's own sum of squares may round the other way.
+	const double bound = (q - impl_->points[near]).squaredNorm() * (1 + 1e-9) + 1e-12;
+	uint32_t idx = 0;
+	double d2 = 0;
+	nanoflann::KNNResultSet<double, uint32_t> result(1);
+	result.init(&idx, &d2);
+	d2 = bound;  // the result set's worst distance: nothing farther is searched
+	impl_->tree.findNeighbors(result, q.data(), nanoflann::SearchParams());
+	if (result.size() == 0) return nearest(q);  // not reached with a finite q
+	return {static_cast<size_t>(idx), d2};
+}
+
 const PointList& PointKDTree::points() const
 {
 	return impl_->points;

@@ -44,17 +44,24 @@ struct Pair
 // transformed other point. Similarities preserve the order of distances, so
 // the query runs in the other map's frame on a tree built once, and the
 // distance is scaled back to ref units.
+// `previous` (the pairs of the transform before, any order, or empty): each
+// reference point's partner there bounds its search (PointKDTree::nearest).
 std::vector<Pair> backwardPairs(
-	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref)
+	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref,
+	const std::vector<Pair>& previous = {})
 {
 	const Similarity2D ref_to_other = other_to_ref.inverse();
 	const Eigen::Matrix2d a = ref_to_other.linear();  // once, not a sine and cosine per point
 	const double s2 = other_to_ref.scale * other_to_ref.scale;
 	std::vector<Pair> pairs(ref.size());
+	const bool hinted = previous.size() == ref.size();
+	if (hinted)
+		for (const Pair& q : previous) pairs[q.ref_idx].other_idx = q.other_idx;
 #pragma omp parallel for schedule(static)
 	for (size_t j = 0; j < ref.size(); ++j)
 	{
-		const auto [i, d2] = other_tree.nearest(a * ref[j] + ref_to_other.t);
+		const Eigen::Vector2d q = a * ref[j] + ref_to_other.t;
+		const auto [i, d2] = hinted ? other_tree.nearest(q, pairs[j].other_idx) : other_tree.nearest(q);
 		pairs[j] = {s2 * d2, j, i};
 	}
 	std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
@@ -94,9 +101,10 @@ struct Trimmed
 	Trimming trimming;
 };
 Trimmed trimmedPairs(
-	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref, const TsICPParams& p)
+	const PointList& ref, const PointKDTree& other_tree, const Similarity2D& other_to_ref, const TsICPParams& p,
+	const std::vector<Pair>& previous = {})
 {
-	Trimmed out{backwardPairs(ref, other_tree, other_to_ref), {}};
+	Trimmed out{backwardPairs(ref, other_tree, other_to_ref, previous), {}};
 	out.trimming = trim(out.pairs, p);
 	return out;
 }
@@ -116,7 +124,7 @@ TsICPResult iterate(
 	for (r.iterations = 1; r.iterations <= max_iterations; ++r.iterations)
 	{
 		const Similarity2D candidate = fitSimilarity(ref, other, pairs, t.count);
-		Trimmed next = trimmedPairs(ref, other_tree, candidate, p);
+		Trimmed next = trimmedPairs(ref, other_tree, candidate, p, pairs);
 		// The re-fit and re-association can only lower ψ in exact arithmetic;
 		// a rise is rounding noise, and keeping the previous transform keeps
 		// the objective monotone.

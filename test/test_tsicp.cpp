@@ -2,6 +2,7 @@
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/GridImage.h>
 #include <multires_map_merge/GroundTruthPair.h>
+#include <multires_map_merge/PointKDTree.h>
 #include <multires_map_merge/TsICP.h>
 
 #include <gtest/gtest.h>
@@ -125,4 +126,39 @@ TEST(ChooseOverlap, TiesGoToTheLargerOverlap)
 	const Trimming t = chooseOverlap(std::vector<double>(50, 0.0), TsICPParams{});
 	EXPECT_EQ(t.count, 50u);
 	EXPECT_DOUBLE_EQ(t.objective, 0.0);
+}
+
+TEST(PointKDTree, AHintBoundsTheSearchAndChangesNoAnswerTiesIncluded)
+{
+	// TsICP bounds each reference point's search by its partner of the
+	// iteration before; the answer must be the unbounded search's, also
+	// where a query lies exactly between lattice points (ties).
+	PairSpec spec;
+	spec.ref_resolution = 0.05;
+	spec.other_resolution = 0.08;
+	const auto pair = makeGroundTruthPair(malaga(), spec);
+	const PointList points = edgesOf(pair.other);
+	ASSERT_GT(points.size(), 1000u);
+	const PointKDTree tree(points);
+	size_t ties = 0;
+	for (size_t k = 0; k < points.size(); k += 7)
+	{
+		// Half a cell off (equidistant from two neighbours when both are
+		// walls), and a few cells off; hints near and far.
+		for (const Eigen::Vector2d& d : {Eigen::Vector2d(0.5, 0), Eigen::Vector2d(0.5, 0.5), Eigen::Vector2d(3.3, -2.1)})
+		{
+			const Eigen::Vector2d q = points[k] + d;
+			const auto plain = tree.nearest(q);
+			ties += std::count_if(points.begin(), points.end(), [&](const Eigen::Vector2d& p) {
+				return (q - p).squaredNorm() == plain.second;
+			}) > 1;
+			for (const size_t hint : {k, plain.first, (k * 7919) % points.size()})
+			{
+				const auto hinted = tree.nearest(q, hint);
+				ASSERT_EQ(hinted.first, plain.first) << "point " << k << " hint " << hint;
+				ASSERT_EQ(hinted.second, plain.second);
+			}
+		}
+	}
+	EXPECT_GT(ties, 100u) << "the tie case must be exercised";
 }

@@ -21,6 +21,11 @@ class PointKDTree
 
 	/** Index of the nearest point and its squared distance. */
 	std::pair<size_t, double> nearest(const Eigen::Vector2d& q) const;
+	/** The same, told that the point `near` lies close to `q` (its distance
+	 * bounds the search, which then skips most of the tree). The answer is
+	 * the same, ties included: only subtrees farther than that bound, which
+	 * hold no nearest point, are left out. */
+	std::pair<size_t, double> nearest(const Eigen::Vector2d& q, size_t near) const;
 	const PointList& points() const;
 
    private:
