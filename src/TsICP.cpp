@@ -53,15 +53,21 @@ std::vector<Pair> backwardPairs(
 	const Similarity2D ref_to_other = other_to_ref.inverse();
 	const Eigen::Matrix2d a = ref_to_other.linear();  // once, not a sine and cosine per point
 	const double s2 = other_to_ref.scale * other_to_ref.scale;
+	// Each reference point's partner before, by its index (`previous` is
+	// sorted by distance).
+	std::vector<size_t> partner_before;
+	if (previous.size() == ref.size())
+	{
+		partner_before.resize(ref.size());
+		for (const Pair& q : previous) partner_before[q.ref_idx] = q.other_idx;
+	}
+	const bool hinted = !partner_before.empty();
 	std::vector<Pair> pairs(ref.size());
-	const bool hinted = previous.size() == ref.size();
-	if (hinted)
-		for (const Pair& q : previous) pairs[q.ref_idx].other_idx = q.other_idx;
 #pragma omp parallel for schedule(static)
 	for (size_t j = 0; j < ref.size(); ++j)
 	{
 		const Eigen::Vector2d q = a * ref[j] + ref_to_other.t;
-		const auto [i, d2] = hinted ? other_tree.nearest(q, pairs[j].other_idx) : other_tree.nearest(q);
+		const auto [i, d2] = hinted ? other_tree.nearest(q, partner_before[j]) : other_tree.nearest(q);
 		pairs[j] = {s2 * d2, j, i};
 	}
 	std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
