@@ -1,6 +1,6 @@
 #include <multires_map_merge/GridImage.h>
-#include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/MapIO.h>
+#include <multires_map_merge/ScanLog.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
