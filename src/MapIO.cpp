@@ -352,8 +352,30 @@ std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, dou
 			errors[i] = std::current_exception();  // an exception may not leave the parallel loop
 		}
 	}
+	// Every file that cannot be read is named at once: a user fixing a
+	// fleet's list should not find the bad files one run at a time.
+	std::vector<std::string> problems;
+	std::exception_ptr first;
 	for (const auto& e : errors)
-		if (e) std::rethrow_exception(e);
+	{
+		if (!e) continue;
+		if (!first) first = e;
+		try
+		{
+			std::rethrow_exception(e);
+		}
+		catch (const MapIOError& bad_file)
+		{
+			problems.push_back(bad_file.what());
+		}
+	}
+	if (problems.size() > 1)
+	{
+		std::string all = std::to_string(problems.size()) + " maps cannot be read: ";
+		for (size_t i = 0; i < problems.size(); ++i) all += (i ? "; " : "") + problems[i];
+		throw MapIOError(all);
+	}
+	if (first) std::rethrow_exception(first);
 	return maps;
 }
 

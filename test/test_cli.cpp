@@ -146,6 +146,11 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 	for (const Bad& b : {
 			 Bad{d + "/nope.gridmap.gz " + d + "/ok.gridmap.gz", "nope.gridmap.gz': no such file"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/garbage.gridmap.gz", "garbage.gridmap.gz': not a serialized"},
+			 // Every bad file of a fleet named in one run.
+			 Bad{d + "/ok.gridmap.gz " + d + "/nope.gridmap.gz " + d + "/garbage.gridmap.gz",
+				 "2 maps cannot be read: '" + d + "/nope.gridmap.gz': no such file"},
+			 Bad{d + "/ok.gridmap.gz " + d + "/nope.gridmap.gz " + d + "/garbage.gridmap.gz",
+				 "; '" + d + "/garbage.gridmap.gz': not a serialized"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --output-resolution fine", "--output-resolution"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --out x.png", "--out must end"},
 			 Bad{d + "/ok.gridmap.gz " + d + "/ok.gridmap.gz --config " + d + "/none.ini", "none.ini': no such config"},

@@ -29,8 +29,9 @@ struct MapIOError : std::runtime_error
  * Rejects empty maps, non-finite metadata and files it cannot read. */
 GridInFrame loadGridMap(const std::string& path, double simplemap_resolution = 0.05);
 
-/** loadGridMap of each path, the files read in parallel; the error of the
- * first path (in their order) that fails is thrown. */
+/** loadGridMap of each path, the files read in parallel. A file that cannot
+ * be read throws its MapIOError; several, one MapIOError naming each (in
+ * the paths' order). */
 std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, double simplemap_resolution = 0.05);
 
 /** Saves .gridmap.gz / .gridmap, or map_server .yaml plus a .pgm beside it
