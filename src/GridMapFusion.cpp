@@ -42,6 +42,22 @@ class OccupancyReader
 		if (cx < 0 || cy < 0 || cx >= w_ || cy >= h_) return 0.5f;
 		return probability_[static_cast<uint8_t>(grid_->getRow(cy)[cx])];
 	}
+	/** The bounding box of the cells that are occupied or free (empty when
+	 * none): every other cell reads as unknown. */
+	cv::Rect knownBox() const
+	{
+		int x0 = w_, y0 = h_, x1 = -1, y1 = -1;
+		for (int cy = 0; cy < h_; ++cy)
+		{
+			const auto* row = grid_->getRow(cy);
+			int first = 0, last = w_ - 1;
+			while (first < w_ && classify(probability_[static_cast<uint8_t>(row[first])]) == kUnknown) ++first;
+			if (first == w_) continue;
+			while (classify(probability_[static_cast<uint8_t>(row[last])]) == kUnknown) --last;
+			x0 = std::min(x0, first), x1 = std::max(x1, last), y0 = std::min(y0, cy), y1 = cy;
+		}
+		return x1 < 0 ? cv::Rect() : cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+	}
 
    private:
 	const COccupancyGridMap2D* grid_;
@@ -50,10 +66,11 @@ class OccupancyReader
 };
 
 // The output columns [first, last) of row `row` where any sub-sample can land
-// in an input grid of in_w × in_h cells, `from_out` taking output cell
-// coordinates to the input's (a few columns of slack each side). Elsewhere
-// every sample falls outside the grid, which leaves the cell as the other
-// maps say (fuseCell(p, 0.5) = p for every p the rule makes).
+// in an input grid (or a box of it: `shift` then taken to the box's corner)
+// of in_w × in_h cells, `from_out` taking output cell coordinates to the
+// input's (a few columns of slack each side). Elsewhere every sample falls
+// outside, which leaves the cell as the other maps say (fuseCell(p, 0.5) = p
+// for every p the rule makes).
 std::pair<int, int> columnsOverGrid(
 	const Eigen::Matrix2d& from_out, const Eigen::Vector2d& shift, int row, int in_w, int in_h, int out_w)
 {
@@ -141,14 +158,19 @@ class InputSampler
 		const int cy1 = std::min(H, int(std::ceil((b.y1 - out_corner.y()) / res)) + 1);
 		touched_ = cv::Rect(cx0, cy0, std::max(0, cx1 - cx0), std::max(0, cy1 - cy0));
 		k_ = samplesPerAxis(res, in_res * m.to_out.scale);
-		in_w_ = static_cast<int>(m.grid->getSizeX()), in_h_ = static_cast<int>(m.grid->getSizeY()), out_w_ = W;
+		// Beyond its known cells an input leaves the output as the others
+		// make it (fuseCell(p, unknown) = p): only they are read. A robot's
+		// map is mostly unexplored margin.
+		known_ = read_.knownBox();
+		out_w_ = W;
 	}
 
 	/** The output columns [first, last) of row `cy` this input can change. */
 	std::pair<int, int> columns(int cy) const
 	{
-		if (cy < touched_.y || cy >= touched_.y + touched_.height) return {0, 0};
-		const auto [first, last] = columnsOverGrid(linear_, shift_, cy, in_w_, in_h_, out_w_);
+		if (cy < touched_.y || cy >= touched_.y + touched_.height || known_.empty()) return {0, 0};
+		const auto [first, last] = columnsOverGrid(
+			linear_, shift_ - Eigen::Vector2d(known_.x, known_.y), cy, known_.width, known_.height, out_w_);
 		return {std::max(first, touched_.x), std::min(last, touched_.x + touched_.width)};
 	}
 
@@ -170,7 +192,8 @@ class InputSampler
 	Eigen::Matrix2d linear_;
 	Eigen::Vector2d shift_;
 	cv::Rect touched_;
-	int k_ = 1, in_w_ = 0, in_h_ = 0, out_w_ = 0;
+	cv::Rect known_;  //!< the input's known cells (OccupancyReader::knownBox)
+	int k_ = 1, out_w_ = 0;
 };
 
 /** The cell rule over any number of placed grids, on the union of their

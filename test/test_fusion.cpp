@@ -6,6 +6,7 @@
 #include <multires_map_merge/MapIO.h>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -121,6 +122,48 @@ TEST(Fusion, ManyMapsInOnePassAnyReferenceOneLeftOut)
 	EXPECT_LE(occupied, 4u);  // one 10 cm cell over at most 2x2 output cells
 	EXPECT_THROW(fuseGridMaps(maps, 1, {zero_in_one, std::nullopt, std::nullopt}, 0.05), std::invalid_argument);
 	EXPECT_THROW(fuseGridMaps(maps, 3, {zero_in_one, Similarity2D(), std::nullopt}, 0.05), std::invalid_argument);
+}
+
+// Fusion reads an input only over the box of its known cells: beyond it, a
+// robot's unexplored margin leaves the output as the other maps make it. A
+// real map inside a wide unknown margin, fused with itself shifted by whole
+// cells: each cell lands on one output cell, so each input's class image in
+// the fusion is the map's own, cell for cell, every known cell arrived.
+TEST(Fusion, ARealMapInAWideMarginArrivesCellForCell)
+{
+	MMM_REQUIRE_SHARED(yaml, "ros_maps/willow/navstage_willow_10cm.yaml");
+	const COccupancyGridMap2D seen = loadGridMap(yaml).grid;
+	const double res = seen.getResolution();
+	constexpr int kMargin = 60;
+	COccupancyGridMap2D padded;
+	padded.setSize(
+		float(seen.getXMin() - kMargin * res), float(seen.getXMax() + kMargin * res),
+		float(seen.getYMin() - kMargin * res), float(seen.getYMax() + kMargin * res), float(res), 0.5f);
+	ASSERT_EQ(padded.getSizeX(), seen.getSizeX() + 2 * kMargin);
+	ASSERT_EQ(padded.getSizeY(), seen.getSizeY() + 2 * kMargin);
+	for (unsigned y = 0; y < seen.getSizeY(); ++y)
+		for (unsigned x = 0; x < seen.getSizeX(); ++x) padded.setCell(x + kMargin, y + kMargin, seen.getCell(x, y));
+	const cv::Mat own = toClassImage(padded);
+	const cv::Rect known = cv::boundingRect(own != kUnknown);
+	ASSERT_GE(known.x, kMargin);  // a wide margin for the fusion to skip
+	ASSERT_GE(known.y, kMargin);
+
+	constexpr int kDx = 7, kDy = -3;
+	const FusedMap f = fuseGridMaps(padded, padded, Similarity2D(1, 0, {kDx * res, kDy * res}), res);
+	// Where each input's cell (0, 0) lands among the output's cells.
+	const COccupancyGridMap2D& out = f.merged.grid;
+	auto cellsFromCorner = [&](double x, double y) {
+		return cv::Point(int(std::lround((x - out.getXMin()) / res)), int(std::lround((y - out.getYMin()) / res)));
+	};
+	const cv::Rect ref_at(cellsFromCorner(padded.getXMin(), padded.getYMin()), own.size());
+	const cv::Rect other_at(cellsFromCorner(padded.getXMin() + kDx * res, padded.getYMin() + kDy * res), own.size());
+	ASSERT_EQ(other_at.tl() - ref_at.tl(), cv::Point(kDx, kDy));
+	const cv::Rect whole(0, 0, int(out.getSizeX()), int(out.getSizeY()));
+	ASSERT_EQ(ref_at & whole, ref_at);
+	ASSERT_EQ(other_at & whole, other_at);
+	EXPECT_EQ(cv::countNonZero(f.ref_classes(ref_at) != own), 0);
+	EXPECT_EQ(cv::countNonZero(f.other_classes(other_at) != own), 0);
+	EXPECT_EQ(cv::countNonZero(f.other_classes != kUnknown), cv::countNonZero(own != kUnknown));
 }
 
 TEST(Fusion, RefusesAbsurdSizesAndBadArguments)
