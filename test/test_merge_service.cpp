@@ -216,6 +216,13 @@ TEST(MergeFleetService, BadRequestsNameTheMapAndTheField)
 	service.mergeFleet(bad, res);
 	EXPECT_FALSE(res.success);
 	EXPECT_NE(res.message.find("maps[2]"), std::string::npos) << res.message;
+	// Several bad maps: each named in the one answer.
+	bad.maps[0].info.resolution = -0.05;
+	service.mergeFleet(bad, res);
+	EXPECT_FALSE(res.success);
+	EXPECT_NE(res.message.find("2 maps are not usable grids"), std::string::npos) << res.message;
+	EXPECT_NE(res.message.find("maps[0]"), std::string::npos) << res.message;
+	EXPECT_NE(res.message.find("maps[2]"), std::string::npos) << res.message;
 	bad = f.req;
 	bad.reference = 3;
 	service.mergeFleet(bad, res);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace multires_map_merge::ros1
 {
@@ -29,6 +31,35 @@ void answerEvenIfItThrows(Response& res, Body body)
 		res.success = false;
 		res.message = std::string("not merged: ") + e.what();
 	}
+}
+
+/** maps[i] of a merge_fleet request as grids. Every message that is not a
+ * usable grid is named in one error, as gridmap-merge names every bad
+ * file: a caller fixing a fleet should not find its bad maps one call at a
+ * time. One bad message gives its own error unchanged. */
+std::vector<GridInFrame> gridsFromMsgs(const std::vector<nav_msgs::OccupancyGrid>& msgs)
+{
+	std::vector<GridInFrame> maps;
+	std::vector<std::string> problems;
+	for (size_t i = 0; i < msgs.size(); ++i)
+	{
+		try
+		{
+			maps.push_back(gridFromMsg(msgs[i], "maps[" + std::to_string(i) + "]"));
+		}
+		catch (const InvalidGridMessage& bad)
+		{
+			problems.push_back(bad.what());
+		}
+	}
+	if (problems.size() == 1) throw InvalidGridMessage(problems.front());
+	if (problems.size() > 1)
+	{
+		std::string all = std::to_string(problems.size()) + " maps are not usable grids: ";
+		for (size_t i = 0; i < problems.size(); ++i) all += (i ? "; " : "") + problems[i];
+		throw InvalidGridMessage(all);
+	}
+	return maps;
 }
 
 /** A request's output_resolution: 0 (the reference's) or metres > 0. */
@@ -104,8 +135,7 @@ void MergeMapsService::mergeFleet(const MergeFleet::Request& req, MergeFleet::Re
 		if (req.reference >= req.maps.size())
 			throw InvalidGridMessage(
 				"reference = " + std::to_string(req.reference) + " but there are " + std::to_string(req.maps.size()) + " maps");
-		std::vector<GridInFrame> maps;
-		for (size_t i = 0; i < req.maps.size(); ++i) maps.push_back(gridFromMsg(req.maps[i], "maps[" + std::to_string(i) + "]"));
+		const std::vector<GridInFrame> maps = gridsFromMsgs(req.maps);
 
 		CScalingGridMapAligner aligner;
 		aligner.options = params_;
