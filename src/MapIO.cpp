@@ -354,8 +354,10 @@ std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, dou
 	}
 	// Every file that cannot be read is named at once: a user fixing a
 	// fleet's list should not find the bad files one run at a time.
+	// A failure that is not the file's (out of memory and the like) is said
+	// as it is, before any file's.
 	std::vector<std::string> problems;
-	std::exception_ptr first;
+	std::exception_ptr first, unexpected;
 	for (const auto& e : errors)
 	{
 		if (!e) continue;
@@ -368,7 +370,12 @@ std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, dou
 		{
 			problems.push_back(bad_file.what());
 		}
+		catch (...)
+		{
+			if (!unexpected) unexpected = e;
+		}
 	}
+	if (unexpected) std::rethrow_exception(unexpected);
 	if (problems.size() > 1)
 	{
 		std::string all = std::to_string(problems.size()) + " maps cannot be read: ";

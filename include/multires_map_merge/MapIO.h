@@ -31,7 +31,8 @@ GridInFrame loadGridMap(const std::string& path, double simplemap_resolution = 0
 
 /** loadGridMap of each path, the files read in parallel. A file that cannot
  * be read throws its MapIOError; several, one MapIOError naming each (in
- * the paths' order). */
+ * the paths' order). A failure that is not a file's (std::bad_alloc) is
+ * rethrown as it is, before any file's. */
 std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, double simplemap_resolution = 0.05);
 
 /** Saves .gridmap.gz / .gridmap, or map_server .yaml plus a .pgm beside it
