@@ -1,6 +1,6 @@
 // The aligner's parameters: one list (key, member, range, meaning) that
 // loading, saving, validation, the ROS keys and docs/parameters.md's table all read.
-#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/AlignerParams.h>
 
 #include "ParamText.h"
 
@@ -13,7 +13,7 @@
 
 namespace multires_map_merge
 {
-using P = CScalingGridMapAligner::TConfigParams;
+using P = AlignerParams;
 using namespace param_text;
 
 const std::vector<AlignerParamField>& alignerParamFields()

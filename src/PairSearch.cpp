@@ -65,7 +65,7 @@ struct Refined
 {
 	bool valid = false;
 	TsICPResult r;
-	Aligner::TCandidate cand;
+	Candidate cand;
 	double icp_s = 0, verify_s = 0;
 };
 
@@ -84,11 +84,11 @@ struct Screen
 	double icp_s = 0, verify_s = 0;
 };
 
-Aligner::TCandidate candidateOf(
+Candidate candidateOf(
 	const PairContext& c, const Hypothesis& h, const TsICPResult& r, double rmse_coarse, double cell_consistency,
 	const Judgement& j)
 {
-	Aligner::TCandidate cand;
+	Candidate cand;
 	cand.initial_cells = h.other_to_ref;
 	cand.cells = r.transform;
 	cand.overlap = r.overlap;
@@ -136,7 +136,7 @@ Screen screenOne(const PairContext& c, const Hypothesis& h)
 /** The screen a screened candidate went through, from what it kept (its
  * sample result and evidence): refining it in full later needs no second
  * screen. Its times were counted when it ran. */
-Screen storedScreen(const Aligner::TCandidate& cand, const TsICPResult& quick)
+Screen storedScreen(const Candidate& cand, const TsICPResult& quick)
 {
 	Screen s;
 	s.ran = s.valid = true;
@@ -149,7 +149,7 @@ Screen storedScreen(const Aligner::TCandidate& cand, const TsICPResult& quick)
 bool onExactFound(const PairContext& c, const SearchState& state, const Similarity2D& t)
 {
 	const Placement at{t, t.apply(c.other.wall_centroid)};
-	return std::any_of(state.exact_found.begin(), state.exact_found.end(), [&](const Aligner::TCandidate& e) {
+	return std::any_of(state.exact_found.begin(), state.exact_found.end(), [&](const Candidate& e) {
 		return samePlacement(at, e.placement(), kSamePlacementCells, kSamePlacementTurnDeg, kSamePlacementScale);
 	});
 }
@@ -268,7 +268,7 @@ bool record(const PairContext& c, SearchState& state, const Hypothesis& h, const
 	state.stage_seconds["icp"] += one.icp_s;
 	state.stage_seconds["verify"] += one.verify_s;
 	if (!one.valid) return false;
-	const Aligner::TCandidate& cand = one.cand;
+	const Candidate& cand = one.cand;
 	state.candidates.push_back(cand);
 	state.refinements.push_back({h, one.r});
 	debug(c, [&](std::ostream& out) {
@@ -319,7 +319,7 @@ bool PairContext::usable(const Similarity2D& t) const
 }
 
 PairContext makeContext(
-	const PreparedMap& ref, const PreparedMap& other, const Aligner::TConfigParams& options,
+	const PreparedMap& ref, const PreparedMap& other, const AlignerParams& options,
 	const mrpt::system::COutputLogger& log, std::map<std::string, double>& stage_seconds)
 {
 	mrpt::system::CTicTac clock;
@@ -448,7 +448,7 @@ size_t refineScreenedRivals(const PairContext& c, SearchState& state, const std:
 	std::vector<size_t> rivals;
 	for (size_t i = 0; i < state.candidates.size(); ++i)
 	{
-		const Aligner::TCandidate& cand = state.candidates[i];
+		const Candidate& cand = state.candidates[i];
 		if (cand.screened && cand.score >= d.runner_up_floor - c.options.screen_margin &&
 			(!of || d.areRivals(*of, cand.placement())))
 			rivals.push_back(i);
@@ -475,7 +475,7 @@ size_t refineScreenedRivals(const PairContext& c, SearchState& state, const std:
 	return rivals.size();
 }
 
-double bestScore(const std::vector<Aligner::TCandidate>& candidates)
+double bestScore(const std::vector<Candidate>& candidates)
 {
 	double best = -std::numeric_limits<double>::infinity();
 	for (const auto& c : candidates)
@@ -484,12 +484,12 @@ double bestScore(const std::vector<Aligner::TCandidate>& candidates)
 	return best;
 }
 
-DecisionCandidate decisionInput(const Aligner::TCandidate& c)
+DecisionCandidate decisionInput(const Candidate& c)
 {
 	return {c.evidence, c.placement(), c.screened, c.mirrored, c.objective};
 }
 
-std::vector<DecisionCandidate> decisionInput(const std::vector<Aligner::TCandidate>& candidates)
+std::vector<DecisionCandidate> decisionInput(const std::vector<Candidate>& candidates)
 {
 	std::vector<DecisionCandidate> in;
 	in.reserve(candidates.size());

@@ -4,7 +4,9 @@
 // at once; the candidates and the evidence the decision reads. Internal to
 // the aligner: not installed.
 
-#include <multires_map_merge/CScalingGridMapAligner.h>
+#include <multires_map_merge/AlignerParams.h>
+#include <multires_map_merge/Candidate.h>
+#include <multires_map_merge/PreparedMap.h>
 
 #include <mrpt/system/COutputLogger.h>
 
@@ -15,14 +17,12 @@
 
 namespace multires_map_merge::pair_search
 {
-using Aligner = CScalingGridMapAligner;
-
 /** What every step of one pair reads; constant while it runs. */
 struct PairContext
 {
 	const PreparedMap& ref;
 	const PreparedMap& other;
-	const Aligner::TConfigParams& options;
+	const AlignerParams& options;
 	const mrpt::system::COutputLogger& log;
 	/** Feature matches of every pyramid level pair: RANSAC's input, and
 	 * evidence about each candidate (Evidence::feature_agreement). */
@@ -48,7 +48,7 @@ struct PairContext
 
 /** The context of a pair; the feature matching is timed as "matches". */
 PairContext makeContext(
-	const PreparedMap& ref, const PreparedMap& other, const Aligner::TConfigParams& options,
+	const PreparedMap& ref, const PreparedMap& other, const AlignerParams& options,
 	const mrpt::system::COutputLogger& log, std::map<std::string, double>& stage_seconds);
 
 /** The evidence about a transform, judged on at most `most` points per map;
@@ -76,11 +76,11 @@ struct SearchState
 	 * lower the best candidate's confidence (the mirror pass's bar is the
 	 * best score found before it). */
 	double least_relevant = 0;
-	std::vector<Aligner::TCandidate> candidates;  //!< in the order refined
+	std::vector<Candidate> candidates;  //!< in the order refined
 	std::vector<Refinement> refinements;  //!< one per candidate
 	/** Candidates whose maps coincide cell for cell: a hypothesis whose
 	 * sample refinement lands on one is not refined again. */
-	std::vector<Aligner::TCandidate> exact_found;
+	std::vector<Candidate> exact_found;
 	size_t hypotheses = 0, hypotheses_refined = 0;
 	std::map<std::string, double> stage_seconds;  //!< icp, verify (summed over threads), ransac, structure
 };
@@ -108,10 +108,10 @@ void refineStructureHypotheses(const PairContext& c, SearchState& state);
 size_t refineScreenedRivals(const PairContext& c, SearchState& state, const std::optional<Placement>& of);
 
 /** The best score of a candidate judged in full (not mirrored); -inf if none. */
-double bestScore(const std::vector<Aligner::TCandidate>& candidates);
+double bestScore(const std::vector<Candidate>& candidates);
 
 /** The decision's view of a candidate. */
-DecisionCandidate decisionInput(const Aligner::TCandidate& c);
-std::vector<DecisionCandidate> decisionInput(const std::vector<Aligner::TCandidate>& candidates);
+DecisionCandidate decisionInput(const Candidate& c);
+std::vector<DecisionCandidate> decisionInput(const std::vector<Candidate>& candidates);
 
 }  // namespace multires_map_merge::pair_search
