@@ -38,6 +38,10 @@ struct BenchContext
 	std::ostream* candidates = nullptr;
 	/** --calibration-data: only the candidates matter (no report's extras). */
 	bool calibration_only = false;
+	/** --pad-to: the Halmstad sensor pairs aligned with each map framed in
+	 * this many cells a side of unknown (its map frame unchanged), as
+	 * gmapping writes its 4000-cell default grid; 0: the files as they are. */
+	int pad_to_cells = 0;
 
 	CScalingGridMapAligner aligner() const;
 	/** Reads --config (sections [aligner] and [fleet]); throws naming it. */

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <optional>
 
 namespace multires_bench
 {
@@ -25,6 +26,26 @@ void HalmstadTally::add(const HalmstadRun& h)
 	if (h.mrpt.seconds > 0) ++mrpt_ran, mrpt_right += h.mrpt_right, mrpt_timeout += !h.mrpt.finished;
 }
 
+namespace
+{
+/** The map in the middle of a grid of `side` cells a side (at least its
+ * own), unknown around it; the same map frame. */
+GridInFrame paddedTo(const GridInFrame& map, int side)
+{
+	const auto& g = map.grid;
+	const int w = int(g.getSizeX()), h = int(g.getSizeY());
+	const int left = std::max(0, side - w) / 2, below = std::max(0, side - h) / 2;
+	const double r = g.getResolution();
+	GridInFrame out;
+	out.kind = map.kind;
+	out.grid.setSize(0, float(std::max(side, w) * r), 0, float(std::max(side, h) * r), float(r), 0.5f);
+	for (int cy = 0; cy < h; ++cy) std::copy(g.getRow(cy), g.getRow(cy) + w, out.grid.getRow(cy + below) + left);
+	// Cell (left, below) of the padded grid is cell (0, 0) of the file's.
+	out.origin = map.origin.compose(Similarity2D(1, 0, {g.getXMin() - left * r, g.getYMin() - below * r}));
+	return out;
+}
+}  // namespace
+
 HalmstadRun runHalmstadPair(
 	const BenchContext& ctx, const HalmstadData& data, const std::string& ref, const std::string& other,
 	const std::string& dir, double mrpt_limit_s)
@@ -38,8 +59,12 @@ HalmstadRun runHalmstadPair(
 	run.calibration = isCalibrationSite(run.site) || isCalibrationSite(siteOf(other));
 	const GridInFrame ref_map = loadGridMap(data.yaml(ref, dir)), other_map = loadGridMap(data.yaml(other, dir));
 	const HalmstadPair* truth = run.positive ? data.pair(other, ref) : nullptr;
+	// Judged on the files as they are; aligned as given (--pad-to: framed).
+	std::optional<GridInFrame> ref_padded, other_padded;
+	if (ctx.pad_to_cells > 0)
+		ref_padded = paddedTo(ref_map, ctx.pad_to_cells), other_padded = paddedTo(other_map, ctx.pad_to_cells);
 	mrpt::system::CTicTac clock;
-	const auto r = ctx.aligner().alignScaled(ref_map, other_map);
+	const auto r = ctx.aligner().alignScaled(ref_padded ? *ref_padded : ref_map, other_padded ? *other_padded : other_map);
 	run.seconds = clock.Tac();
 	run.merged = r.success;
 	run.confidence = r.confidence;

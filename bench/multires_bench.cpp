@@ -260,6 +260,10 @@ int main(int argc, char** argv)
 		"", "SITES", cmd);
 	TCLAP::ValueArg<std::string> halmstad_arg(
 		"", "halmstad-only", "only the real-independent-maps section, on these sites (e.g. E5,HIH)", false, "", "SITES", cmd);
+	TCLAP::ValueArg<int> pad_arg(
+		"", "pad-to",
+		"with --halmstad-only: each map framed in this many cells a side of unknown (gmapping's default grid is 4000)",
+		false, 0, "CELLS", cmd);
 	TCLAP::ValueArg<int> negatives_arg(
 		"", "halmstad-negatives", "cross-site negatives per map (with --halmstad-only)", false, 8, "N", cmd);
 	TCLAP::ValueArg<std::string> sets_arg(
@@ -342,6 +346,7 @@ int main(int argc, char** argv)
 		if (coarser_arg.isSet()) return coarserOnly(ctx, coarser_arg.getValue());
 		if (partial_arg.isSet()) return partialOnly(ctx, partial_arg.getValue());
 		if (floor_plans_arg.isSet()) return floorPlansOnly(ctx, floor_plans_arg.getValue());
+		ctx.pad_to_cells = pad_arg.getValue();
 		if (halmstad_arg.isSet()) return halmstadOnly(ctx, halmstad_arg.getValue(), negatives_arg.getValue());
 		if (sets_arg.isSet()) return runAccuracySets(ctx, sets_arg.getValue());
 		if (negatives_only_arg.isSet()) return negativesOnly(ctx);
