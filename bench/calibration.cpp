@@ -112,10 +112,8 @@ void writeFinishedCandidates(const BenchContext& ctx, const PairNames& names, co
 	const GridInFrame& other, const CScalingGridMapAligner::TReturnInfo& r, const CandidateError& error_of)
 {
 	const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
-	const auto& o = ctx.options;
 	writeCandidates(ctx, names.site, names.ref, names.other, names.positive, true, r, error_of, [&](const auto& c) {
-		return finishBent(
-			*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision);
+		return bentFinished(ctx, *ref_prepared, *other_prepared, c);
 	});
 }
 

@@ -170,9 +170,12 @@ PairResult runPair(
 	{
 		const Similarity2D truth_cells = ref.cellToMapFrame().inverse().compose(truth).compose(other.cellToMapFrame());
 		// The aligner's last refinement, started at the truth.
+		const auto prepared = [&](const GridInFrame& m) { return aligner.prepare(m.grid); };
+		const auto ref_p = prepared(ref), other_p = prepared(other);
 		const Similarity2D at_truth = aligner.options.icp_finish_on_occupied
-			? finishOnOccupied(*aligner.prepare(ref.grid), *aligner.prepare(other.grid), truth_cells,
-							   aligner.options.icpParams(), aligner.options.latticeParams())
+			? gridCells(*ref_p, finishOnOccupied(*ref_p, *other_p, preparedCells(*ref_p, truth_cells, *other_p),
+									 aligner.options.icpParams(), aligner.options.latticeParams()),
+						*other_p)
 			: runTsICP(edgePoints(toClassImage(ref.grid)), edgePoints(toClassImage(other.grid)), truth_cells,
 					   aligner.options.icpParams()).transform;
 		p.floor_rmse = pointRmse(ref.cellToMapFrame().compose(at_truth).compose(other.cellToMapFrame().inverse()),

@@ -44,6 +44,17 @@ std::string candidateHeader()
 	return header + "\n";
 }
 
+Similarity2D bentFinished(
+	const BenchContext& ctx, const PreparedMap& ref, const PreparedMap& other,
+	const CScalingGridMapAligner::TCandidate& c)
+{
+	const auto& o = ctx.options;
+	const Similarity2D finished = finishBent(
+		ref, other, preparedCells(ref, c.cells, other), o.decision.exactConfidence(c.evidence), o.finishParams(),
+		o.decision);
+	return gridCells(ref, finished, other);
+}
+
 std::pair<double, bool> noTruth(const Similarity2D&) { return {NAN, false}; }
 
 void writeCandidates(

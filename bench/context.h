@@ -19,6 +19,7 @@ namespace multires_bench
 {
 using multires_map_merge::CScalingGridMapAligner;
 using multires_map_merge::Similarity2D;
+using multires_map_merge::PreparedMap;
 using multires_map_merge::FleetParams;
 
 struct BenchContext
@@ -61,6 +62,11 @@ std::string candidateHeader();
 using ErrorOf = std::function<std::pair<double, bool>(const Similarity2D& cells)>;
 /** The transform a candidate would be reported with, if decided on. */
 using ReportedOf = std::function<Similarity2D(const CScalingGridMapAligner::TCandidate&)>;
+/** A candidate (grid cells) as the aligner would report it for maps that
+ * bend (finishBent, which works in the prepared maps' cells). */
+Similarity2D bentFinished(
+	const BenchContext& ctx, const PreparedMap& ref, const PreparedMap& other,
+	const CScalingGridMapAligner::TCandidate& c);
 /** For negatives: no candidate can be right. */
 std::pair<double, bool> noTruth(const Similarity2D&);
 

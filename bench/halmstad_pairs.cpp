@@ -104,10 +104,7 @@ HalmstadRun runHalmstadPair(
 		return std::pair<double, bool>{o.mean_displacement_px, o.right};
 	};
 	writeCandidates(ctx, run.site, ref, other, run.positive, run.calibration, r, error_of, [&](const auto& c) {
-		const auto& o = ctx.options;
-		return ref_prepared
-			? finishBent(*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence), o.finishParams(), o.decision)
-			: c.cells;
+		return ref_prepared ? bentFinished(ctx, *ref_prepared, *other_prepared, c) : c.cells;
 	});
 	std::cout << "halmstad " << ref << " <- " << other << ": "
 			  << (run.positive ? (run.merged ? (run.outcome.right ? "merged right" : "MERGED WRONG") : "refused")

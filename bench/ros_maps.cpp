@@ -195,18 +195,13 @@ RosMapsRun runPair(
 		if (record)
 		{
 			const auto ref_prepared = ctx.aligner().prepare(ref.grid), other_prepared = ctx.aligner().prepare(other.grid);
-			const auto& o = ctx.options;
 			writeCandidates(
 				ctx, "ros", run.ref, run.other, true, true, r,
 				[&](const Similarity2D& cells) {
 					const double e = displacement(candidateMetric(ref, cells, other));
 					return std::pair<double, bool>{e, e <= kRosRightCells};
 				},
-				[&](const auto& c) {
-					return finishBent(
-						*ref_prepared, *other_prepared, c.cells, o.decision.exactConfidence(c.evidence),
-						o.finishParams(), o.decision);
-				});
+				[&](const auto& c) { return bentFinished(ctx, *ref_prepared, *other_prepared, c); });
 		}
 	}
 	std::cout << "ros maps";

@@ -16,10 +16,22 @@ namespace multires_map_merge
 using P = AlignerParams;
 using namespace param_text;
 
+namespace
+{
+/** Pixels of unknown around each feature level of a cropped map: SIFT finds
+ * nothing within 5 pixels of an octave's border, 10 and 20 level pixels at
+ * its second and third octaves. */
+constexpr int kCroppedLevelFrame = 16;
+}  // namespace
+
 const std::vector<AlignerParamField>& alignerParamFields()
 {
 	constexpr bool off0 = true, no0 = false;
 	static const std::vector<AlignerParamField> fields{
+		// Preparation (PreparedMap.h)
+		{"crop_to_known", &P::crop_to_known, 0, 1, no0,
+		 "Prepare each map as the box of its known cells, so unknown padding around it changes nothing (off "
+		 "until the decision is calibrated on it)"},
 		// Features and RANSAC (FeatureHypotheses.h)
 		{"pyramid_levels", &P::pyramid_levels, 1, 8, no0, "Resolution levels per map (each halves the cells per axis)"},
 		{"feature_max_level_cells", &P::feature_max_level_cells, 4096, 1e10, no0,
@@ -138,6 +150,14 @@ FeatureParams P::featureParams() const
 	p.ransac_iterations = ransac_iterations;
 	p.min_inliers = ransac_min_inliers;
 	p.hypotheses_per_level_pair = hypotheses_per_level_pair;
+	if (crop_to_known)
+	{
+		// A cropped map is no longer a square of padding: its levels by its
+		// longer side, framed (SIFT keeps 5 pixels clear of an octave's
+		// border, 2 pixels of the margin at a ×8 level).
+		p.levels_by_longer_side = true;
+		p.level_frame = kCroppedLevelFrame;
+	}
 	return p;
 }
 

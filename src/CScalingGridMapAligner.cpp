@@ -65,11 +65,12 @@ CScalingGridMapAligner::PreparedMapPtr CScalingGridMapAligner::prepare(
 		p->problem = why.str();
 		return p;
 	}
-	p->cell_to_metric = cellToMetric(grid);
-
-	// 1. The map as an image; features over a resolution pyramid (describe).
+	// 1. The map as an image (with crop_to_known, its known part); features
+	// over a resolution pyramid (describe).
 	mrpt::system::CTicTac stage;
 	p->classes = toClassImage(grid);
+	if (options.crop_to_known) p->classes = knownPart(p->classes, kKnownMargin, p->grid_corner);
+	p->cell_to_metric = cellToMetric(grid).compose(p->toGridCells());
 	p->stage_seconds["features"] = stage.Tac();
 	// Said plainly here rather than as "no feature matches" later.
 	const int occupied = cv::countNonZero(p->classes == kOccupied), free = cv::countNonZero(p->classes == kFree);
@@ -182,7 +183,8 @@ CScalingGridMapAligner::TReturnInfo swappedBack(
 		c.cells = c.cells.inverse(), c.initial_cells = c.initial_cells.inverse();
 		// A mirrored candidate now starts from the mirrored other map (the
 		// swapped alignment's mirrored reference, made by its mirror pass).
-		c.other_centre = c.cells.apply(c.mirrored ? other.mirrored()->wall_centroid : other.wall_centroid);
+		c.other_centre = c.cells.apply(
+			other.toGridCells().apply(c.mirrored ? other.mirrored()->wall_centroid : other.wall_centroid));
 	}
 	return r;
 }
@@ -211,7 +213,32 @@ CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignScaled(
 	return info;
 }
 
+namespace
+{
+/** A result between prepared maps' cells (crop_to_known: their known parts)
+ * as one between their grids' cells, as the aligner reports it. */
+void toGridCells(CScalingGridMapAligner::TReturnInfo& info, const PreparedMap& ref, const PreparedMap& other)
+{
+	info.cells = gridCells(ref, info.cells, other);
+	info.initial_cells = gridCells(ref, info.initial_cells, other);
+	for (auto& c : info.candidates)
+	{
+		c.cells = gridCells(ref, c.cells, other);
+		c.initial_cells = gridCells(ref, c.initial_cells, other);
+		c.other_centre = ref.toGridCells().apply(c.other_centre);
+	}
+}
+}  // namespace
+
 CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::align(
+	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const
+{
+	TReturnInfo info = alignInPreparedCells(ref, other, start_metric);
+	toGridCells(info, ref, other);
+	return info;
+}
+
+CScalingGridMapAligner::TReturnInfo CScalingGridMapAligner::alignInPreparedCells(
 	const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const
 {
 	mrpt::system::CTicTac total, stage;

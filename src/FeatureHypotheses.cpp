@@ -3,6 +3,7 @@
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,8 @@ namespace multires_map_merge
 bool sameExtraction(const FeatureParams& a, const FeatureParams& b)
 {
 	return a.pyramid_levels == b.pyramid_levels && a.min_level_size == b.min_level_size &&
-		a.max_level_cells == b.max_level_cells && a.sift_contrast_threshold == b.sift_contrast_threshold &&
+		a.max_level_cells == b.max_level_cells && a.levels_by_longer_side == b.levels_by_longer_side &&
+		a.level_frame == b.level_frame && a.sift_contrast_threshold == b.sift_contrast_threshold &&
 		a.sift_edge_threshold == b.sift_edge_threshold && a.unknown_as_free == b.unknown_as_free;
 }
 
@@ -21,13 +23,19 @@ std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const 
 {
 	auto sift = cv::SIFT::create(0, 3, p.sift_contrast_threshold, p.sift_edge_threshold);
 	std::vector<LevelFeatures> levels;
-	const double cells = double(classes.cols) * classes.rows;
+	// The level's size against max_level_cells, and its side against min_level_size.
+	const double cells = p.levels_by_longer_side ? std::pow(std::max(classes.cols, classes.rows), 2.0)
+												 : double(classes.cols) * classes.rows;
+	const double side = p.levels_by_longer_side ? std::max(classes.cols, classes.rows)
+												: std::min(classes.cols, classes.rows);
+	const int frame = p.level_frame;
 	for (int l = 0; int(levels.size()) < p.pyramid_levels; ++l)
 	{
 		const double f = std::ldexp(1.0, -l);
 		if (cells * f * f > p.max_level_cells) continue;
-		if (std::min(classes.cols, classes.rows) * f < p.min_level_size && !levels.empty()) break;
+		if (side * f < p.min_level_size && !levels.empty()) break;
 		cv::Mat img = l == 0 ? classes.clone() : resampleClasses(classes, f);
+		if (frame > 0) cv::copyMakeBorder(img, img, frame, frame, frame, frame, cv::BORDER_CONSTANT, kUnknown);
 		if (p.unknown_as_free) img.setTo(kFree, img == kUnknown);
 		LevelFeatures lf;
 		lf.scale = f;
@@ -35,7 +43,8 @@ std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const 
 		sift->detectAndCompute(img, cv::noArray(), kps, lf.descriptors);
 		for (const auto& k : kps)  // level pixel centre → full-resolution cell
 			lf.points.emplace_back(
-				static_cast<float>((k.pt.x + 0.5) / f - 0.5), static_cast<float>((k.pt.y + 0.5) / f - 0.5));
+				static_cast<float>((k.pt.x - frame + 0.5) / f - 0.5),
+				static_cast<float>((k.pt.y - frame + 0.5) / f - 0.5));
 		levels.push_back(std::move(lf));
 	}
 	return levels;

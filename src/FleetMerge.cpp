@@ -27,15 +27,17 @@ bool FleetResult::allPlaced() const
 
 namespace
 {
-/** The WallSpread of `from`'s walls that `cells` (from's cells → to's)
+/** The WallSpread of `from`'s walls that `cells` (from's grid cells → to's)
  * puts on space `to` saw (FleetEdge::overlap); none with fewer than three. */
 std::optional<WallSpread> overlapSpread(
 	const GridInFrame& from, const PreparedMap& from_prepared, const PreparedMap& to_prepared,
 	const Similarity2D& cells)
 {
+	const Similarity2D between_prepared = preparedCells(to_prepared, cells, from_prepared);
+	const Eigen::Vector2d from_corner = from_prepared.toGridCells().t;
 	PointList shared;
 	for (const auto& p : occupiedPoints(from_prepared.classes))
-		if (onMask(to_prepared.field.known, cells(p))) shared.push_back(p);
+		if (onMask(to_prepared.field.known, between_prepared(p))) shared.push_back(p + from_corner);
 	if (shared.size() < 3) return std::nullopt;
 	return spreadOf(shared, from.cellToMapFrame());
 }
@@ -238,7 +240,7 @@ std::vector<WallSpread> wallSpreadOf(const std::vector<GridInFrame>& maps, const
 	for (size_t m = 0; m < maps.size(); ++m)
 	{
 		const bool have = m < prepared.size() && prepared[m] && !prepared[m]->classes.empty();
-		out.push_back(have ? wallSpread(maps[m], prepared[m]->classes) : wallSpread(maps[m]));
+		out.push_back(have ? wallSpread(maps[m], prepared[m]->classes, prepared[m]->grid_corner) : wallSpread(maps[m]));
 	}
 	return out;
 }

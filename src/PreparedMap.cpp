@@ -5,6 +5,8 @@
 
 #include <mrpt/system/CTicTac.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <future>
 
@@ -47,6 +49,35 @@ void describeMap(PreparedMap& p)
 	p.stage_seconds["edges"] += stage.Tac();
 }
 
+cv::Mat knownPart(const cv::Mat& classes, int margin, cv::Point& corner)
+{
+	const cv::Rect known = cv::boundingRect(classes != kUnknown);
+	corner = {0, 0};
+	if (known.empty()) return classes;
+	const cv::Rect box(known.x - margin, known.y - margin, known.width + 2 * margin, known.height + 2 * margin);
+	const cv::Rect inside = box & cv::Rect(0, 0, classes.cols, classes.rows);
+	cv::Mat part(box.size(), CV_8UC1, cv::Scalar(kUnknown));
+	classes(inside).copyTo(part(inside - box.tl()));
+	corner = box.tl();
+	return part;
+}
+
+// Shifts only (written out, not composed: uncropped maps keep their
+// transforms bit for bit, angles unwrapped).
+Similarity2D gridCells(const PreparedMap& ref, const Similarity2D& prepared_cells, const PreparedMap& other)
+{
+	Similarity2D out = prepared_cells;
+	out.t += ref.toGridCells().t - out.linear() * other.toGridCells().t;
+	return out;
+}
+
+Similarity2D preparedCells(const PreparedMap& ref, const Similarity2D& grid_cells, const PreparedMap& other)
+{
+	Similarity2D out = grid_cells;
+	out.t += out.linear() * other.toGridCells().t - ref.toGridCells().t;
+	return out;
+}
+
 PreparedMapPtr PreparedMap::mirrored() const
 {
 	return mirror_cache.get([this] { return mirroredMap(*this); });
@@ -63,7 +94,8 @@ PreparedMapPtr mirroredMap(const PreparedMap& map)
 	p->resolution = map.resolution;
 	p->kind = map.kind;
 	p->feature_params = map.feature_params;
-	p->cell_to_metric = map.cell_to_metric;  // not a frame: only cells are compared
+	p->grid_corner = map.grid_corner;  // neither a frame: only cells are compared
+	p->cell_to_metric = map.cell_to_metric;
 	cv::flip(map.classes, p->classes, 1);
 	// SIFT is not mirror-symmetric: the features anew, on another thread
 	// (one map here, not two at once). The edges and the field are the map's

@@ -28,12 +28,13 @@ WallSpread spreadOf(const PointList& cells, const Similarity2D& to_frame)
 	return out;
 }
 
-WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes)
+WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes, cv::Point corner)
 {
 	// Its walls; a map with almost none: what it saw; nothing: the whole grid.
 	PointList cells_seen = occupiedPoints(classes);
 	if (cells_seen.size() < 3) cells_seen = cellsOf(classes != kUnknown);
 	if (cells_seen.size() < 3) cells_seen = cellsOf(cv::Mat::ones(classes.size(), CV_8U));
+	for (auto& c : cells_seen) c += Eigen::Vector2d(corner.x, corner.y);  // into the grid's cells
 	return spreadOf(cells_seen, map.cellToMapFrame());
 }
 

@@ -13,6 +13,7 @@
 #include <map>
 #include <thread>
 
+#include "grid_padding.h"
 #include "test_data.h"
 
 using namespace multires_map_merge;
@@ -200,6 +201,37 @@ TEST(PreparedMaps, AlignAsTheGridsDoAndRefuseOtherFeatureOptions)
 	mrpt::maps::COccupancyGridMap2D tiny(0, 0.2, 0, 0.2, 0.05);
 	const auto t = aligner.alignScaled(*ref, *aligner.prepare(tiny));
 	EXPECT_EQ(t.message.rfind("other map is too small", 0), 0u) << t.message;
+}
+
+// A map file is often mostly unknown around what the robot saw (gmapping's
+// grid is 4000 cells across whatever it mapped). Prepared as its known part,
+// the padding changes nothing: the same prepared images, the same alignment.
+TEST(PreparedMaps, CroppedToTheKnownPartPaddingChangesNothing)
+{
+	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 30, 0.6});
+	CScalingGridMapAligner aligner;
+	aligner.options.crop_to_known = true;
+	const auto ref_padded = test::padded(pair.ref, 300, 40, 120), other_padded = test::padded(pair.other, 7, 210, 0);
+	ASSERT_EQ(ref_padded.getSizeX(), pair.ref.getSizeX() + 420);
+	const auto ref = aligner.prepare(pair.ref), ref_p = aligner.prepare(ref_padded);
+	const auto other = aligner.prepare(pair.other), other_p = aligner.prepare(other_padded);
+	ASSERT_EQ(ref->classes.size(), ref_p->classes.size());
+	EXPECT_EQ(cv::countNonZero(ref->classes != ref_p->classes), 0);
+	EXPECT_EQ(ref_p->grid_corner - ref->grid_corner, cv::Point(300, 40));
+	EXPECT_EQ(other_p->grid_corner - other->grid_corner, cv::Point(7, 210));
+	EXPECT_LE(ref_p->classes.cols, int(ref_padded.getSizeX()) - 420 + 2 * kKnownMargin);
+
+	const auto r = aligner.alignScaled(*ref, *other), r_p = aligner.alignScaled(*ref_p, *other_p);
+	expectAccurate(pair, r);  // reported in the grids' cells and metres
+	ASSERT_TRUE(r_p.success) << r_p.message;
+	EXPECT_EQ(r_p.confidence, r.confidence);
+	EXPECT_EQ(r_p.cells.scale, r.cells.scale);
+	EXPECT_EQ(r_p.cells.yaw, r.cells.yaw);
+	EXPECT_LT((r_p.metric.t - r.metric.t).norm(), 1e-5);  // metres: MRPT keeps grid corners in float
+	EXPECT_NEAR(r_p.metric.yaw, r.metric.yaw, 1e-12);
+	// In the padded grids' cells: the same placement, shifted by the padding.
+	const Similarity2D shift_ref(1, 0, {300, 40}), shift_other(1, 0, {7, 210});
+	EXPECT_LT((r_p.cells.t - shift_ref.compose(r.cells).compose(shift_other.inverse()).t).norm(), 1e-6);
 }
 
 // A live fleet tracks a placed pair as its maps grow: refined from the last

@@ -23,6 +23,7 @@
 #include <memory>
 
 #include "cli_run.h"
+#include "grid_padding.h"
 #include "test_data.h"
 
 using namespace multires_map_merge;
@@ -161,6 +162,41 @@ bool hangsOnOnePair(const FleetResult& r, size_t m)
 // With second_path_tries (1, the default), a robot placed by one pair looks
 // for a second path, so a cycle checks that pair; at 0, the two robots
 // placed directly on the reference hang on their one pair each.
+// Prepared as their known parts (crop_to_known), maps padded with unknown
+// are placed as they are without it: the same placements, and each pair is
+// weighed where it measured (FleetEdge::overlap) in the maps' own frames.
+TEST(Fleet, CroppedToTheirKnownPartsPaddedMapsArePlacedAsTheyAre)
+{
+	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");
+	const Fleet& f = *fleet();
+	std::vector<GridInFrame> padded_maps = f.maps;
+	for (size_t m = 0; m < padded_maps.size(); ++m)
+		padded_maps[m].grid = test::padded(f.maps[m].grid, 150 + 40 * int(m), 90, 60);
+	CScalingGridMapAligner cropping;
+	cropping.options.crop_to_known = true;
+	const FleetResult r = placeFleet(f.maps, 0, cropping), r_padded = placeFleet(padded_maps, 0, cropping);
+	ASSERT_EQ(r.edges.size(), r_padded.edges.size());
+	for (size_t m = 1; m + 1 < f.maps.size(); ++m)
+	{
+		ASSERT_TRUE(r_padded.maps[m].placed) << f.robots[m].file << ": " << r_padded.maps[m].message;
+		EXPECT_LE(errorCoarseCells(f, m, r_padded.maps[m].in_reference), 2.0) << f.robots[m].file;
+		EXPECT_LT(wallRms(wallSpread(f.maps[m]), r_padded.maps[m].in_reference, r.maps[m].in_reference), 1e-4)
+			<< f.robots[m].file;
+	}
+	EXPECT_FALSE(r_padded.maps.back().placed);
+	size_t overlaps = 0;
+	for (size_t k = 0; k < r.edges.size(); ++k)
+	{
+		const FleetEdge &e = r.edges[k], &e_padded = r_padded.edges[k];
+		ASSERT_EQ(e.overlap.has_value(), e_padded.overlap.has_value()) << e.from << " -> " << e.to;
+		if (!e.overlap) continue;
+		++overlaps;
+		for (size_t c = 0; c < 4; ++c)
+			EXPECT_LT(((*e.overlap)[c] - (*e_padded.overlap)[c]).norm(), 1e-4) << e.from << " -> " << e.to;
+	}
+	EXPECT_GE(overlaps, 3u);
+}
+
 TEST(Fleet, ARobotHangingOnOnePairLooksForASecondPathWhenAsked)
 {
 	MMM_REQUIRE_SHARED(log, "carmen_corrected/freiburg-079-corrected.log.gz");

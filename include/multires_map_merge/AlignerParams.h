@@ -20,6 +20,17 @@ namespace multires_map_merge
 {
 struct AlignerParams : public mrpt::config::CLoadableOptions
 {
+	// --- Preparation (PreparedMap.h)
+	/** Each map prepared as its known part: the box of its occupied and
+	 * free cells plus kKnownMargin cells of unknown (PreparedMap::
+	 * grid_corner), its feature levels sized by the box's longer side and
+	 * framed in unknown (FeatureParams). How much unknown a file holds
+	 * around what a robot saw then changes nothing, neither the result nor
+	 * the time: a gmapping grid is 4000 cells across whatever it mapped.
+	 * Results stay in the grids' cells. Off by default until the decision
+	 * is calibrated on its candidates (docs/method.md, step 0). */
+	bool crop_to_known = false;
+
 	// --- Features and RANSAC (initial hypotheses)
 	int pyramid_levels = 4;  //!< per map; each level halves the cell count per axis
 	/** Pyramid levels larger than this are not searched for features

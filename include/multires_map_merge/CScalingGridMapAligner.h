@@ -151,8 +151,12 @@ class CScalingGridMapAligner : public mrpt::slam::CMetricMapsAlignmentAlgorithm
 	TReturnInfo alignGrids(
 		const mrpt::maps::COccupancyGridMap2D& ref, MapKind ref_kind, const mrpt::maps::COccupancyGridMap2D& other,
 		MapKind other_kind) const;
-	/** The search, decision and finish of one pair (a given start first). */
+	/** The search, decision and finish of one pair (a given start first),
+	 * reported in the grids' cells. */
 	TReturnInfo align(
+		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
+	/** The same in the prepared maps' cells (PreparedMap::grid_corner). */
+	TReturnInfo alignInPreparedCells(
 		const TPreparedMap& ref, const TPreparedMap& other, const std::optional<Similarity2D>& start_metric) const;
 	/** mirror_check: the other map aligned to the reference mirrored
 	 * (feature hypotheses only); its candidates join `search` as rivals. Returns their best

@@ -28,6 +28,17 @@ struct FeatureParams
 	 * of the whole alignment, and the seeds it finds are no better than a
 	 * coarser level's (TsICP refines on the full-resolution edges anyway). */
 	double max_level_cells = 1 << 18;
+	/** Levels sized by the image's longer side instead: at most
+	 * √max_level_cells across, smaller ones kept down to min_level_size on
+	 * that side. A map cropped to its known part is often long and narrow:
+	 * by cell count and shorter side it would lose its finer level or its
+	 * coarser ones, which a square grid of padding kept. */
+	bool levels_by_longer_side = false;
+	/** Pixels of unknown drawn around each level before SIFT, whose
+	 * keypoints stay 5 pixels clear of each octave's border and whose blur
+	 * reads past it: a map cropped close to its outermost walls keeps the
+	 * features there. 0: the level as it is. */
+	int level_frame = 0;
 	double sift_contrast_threshold = 0.04;
 	double sift_edge_threshold = 10;
 	double ratio_test = 0.8;  //!< Lowe's ratio for accepting a match

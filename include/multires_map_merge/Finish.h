@@ -3,7 +3,8 @@
 // maps whose cells coincide (two parts of one SLAM run) are refined on every
 // occupied cell and shifted onto the coarser map's lattice; maps that bend
 // (independent runs) are refit over the whole overlap. The decision is made
-// before, on the edges.
+// before, on the edges. Transforms here are between the prepared maps' cells
+// (PreparedMap::grid_corner; preparedCells takes a reported one there).
 
 #include <multires_map_merge/Decision.h>
 #include <multires_map_merge/LatticeShift.h>

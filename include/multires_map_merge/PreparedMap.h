@@ -60,7 +60,15 @@ struct PreparedMap
 	std::string problem;
 	MapKind kind = MapKind::Sensed;  //!< a floor plan's field claims only its walls
 	double resolution = 0;  //!< as stated
-	Similarity2D cell_to_metric;  //!< the grid's cells → its metric frame
+	/** The prepared cells' (0, 0) is this cell of the grid it was prepared
+	 * from: (0, 0), or with crop_to_known the corner of its known box
+	 * widened by kKnownMargin (negative where that passes the grid's edge).
+	 * Everything below is in prepared cells; the aligner's results are
+	 * reported in the grids' (gridCells). */
+	cv::Point grid_corner{0, 0};
+	/** The prepared cells → the cells of the grid (a shift by grid_corner). */
+	Similarity2D toGridCells() const { return Similarity2D(1, 0, Eigen::Vector2d(grid_corner.x, grid_corner.y)); }
+	Similarity2D cell_to_metric;  //!< the prepared cells → the grid's metric frame
 	cv::Mat classes;  //!< GridImage.h
 	FeatureParams feature_params;  //!< those the features were extracted with
 	std::vector<LevelFeatures> features;
@@ -87,6 +95,21 @@ struct PreparedMap
 	OnceCache<MapWalls> walls_cache;
 };
 using PreparedMapPtr = std::shared_ptr<const PreparedMap>;
+
+/** Cells of unknown kept around a map's known box when it is cropped
+ * (crop_to_known): its outermost walls keep unknown beyond them, as edge
+ * points, occupancy field and structure search see them in a padded grid. */
+constexpr int kKnownMargin = 16;
+
+/** The class image of a map's known part: its occupied and free cells' box
+ * widened by `margin` cells of unknown (past the image's edge too), and that
+ * box's corner in `classes`. An image with no known cell is kept whole. */
+cv::Mat knownPart(const cv::Mat& classes, int margin, cv::Point& corner);
+
+/** A transform between two prepared maps' cells (other → ref) as one between
+ * their grids' cells, and back. */
+Similarity2D gridCells(const PreparedMap& ref, const Similarity2D& prepared_cells, const PreparedMap& other);
+Similarity2D preparedCells(const PreparedMap& ref, const Similarity2D& grid_cells, const PreparedMap& other);
 
 /** Features, edge points and occupancy field of a map's `classes`, with its
  * `feature_params`. */

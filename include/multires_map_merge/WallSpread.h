@@ -27,10 +27,11 @@ using WallSpread = std::array<Eigen::Vector2d, 4>;
 /** Four points with the mean and the spread of `cells` (cell coordinates,
  * at least one), in the map's frame (`to_frame`: cells → frame). */
 WallSpread spreadOf(const PointList& cells, const Similarity2D& to_frame);
-/** The WallSpread of a map's walls, from its class image (GridImage.h): its
- * occupied cells; with fewer than three, its known cells; none known, the
- * whole grid. */
-WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes);
+/** The WallSpread of a map's walls, from its class image (GridImage.h) or
+ * the part of it whose (0, 0) is the grid's cell `corner` (a prepared map's,
+ * PreparedMap::grid_corner): its occupied cells; with fewer than three, its
+ * known cells; none known, the whole image. */
+WallSpread wallSpread(const GridInFrame& map, const cv::Mat& classes, cv::Point corner = {0, 0});
 /** The same from the map's grid. */
 WallSpread wallSpread(const GridInFrame& map);
 
