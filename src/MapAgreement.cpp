@@ -74,11 +74,11 @@ cv::Mat wallNormals(const cv::Mat& occupied)
 // Walls whose normals differ by at most this run the same way.
 constexpr double kSameDirectionDeg = 20.0;
 
-// How a point landing on target cell (x, y), inside the map, is judged:
-// near a wall counts even where the target has not seen the exact cell
-// (walls border unknown space); elsewhere only seen space judges, and a
-// point there farther than the tolerance from any wall or unknown cell is a
-// wall where the target clearly sees none.
+// How a point landing on target cell (x, y) is judged: near a wall counts
+// even where the target has not seen the exact cell (walls border unknown
+// space); elsewhere only seen space judges, and a point there farther than
+// the tolerance from any wall or unknown cell is a wall where the target
+// clearly sees none.
 enum class Landing
 {
 	Unjudged,
@@ -88,9 +88,22 @@ enum class Landing
 };
 Landing landing(const OccupancyField& target, int x, int y, double tolerance)
 {
-	if (target.dist_to_occupied.at<float>(y, x) <= tolerance) return Landing::Supported;
-	if (!target.known.at<uint8_t>(y, x)) return Landing::Unjudged;
-	return target.dist_to_not_free.at<float>(y, x) > tolerance ? Landing::Conflicting : Landing::Agreeing;
+	const int w = target.known.cols, h = target.known.rows;
+	if (x >= 0 && y >= 0 && x < w && y < h)
+	{
+		if (target.dist_to_occupied.at<float>(y, x) <= tolerance) return Landing::Supported;
+		if (!target.known.at<uint8_t>(y, x)) return Landing::Unjudged;
+		return target.dist_to_not_free.at<float>(y, x) > tolerance ? Landing::Conflicting : Landing::Agreeing;
+	}
+	if (!target.empty_beyond || w == 0 || h == 0) return Landing::Unjudged;
+	// Beyond a plan's image: judged from the image's nearest cell c, d away.
+	// A wall is at most d + its distance from c; the building, inside the
+	// image (a convex box), at least hypot(d, its distance from c).
+	const int cx = std::clamp(x, 0, w - 1), cy = std::clamp(y, 0, h - 1);
+	const double d = std::hypot(double(x - cx), double(y - cy));
+	if (target.dist_to_occupied.at<float>(cy, cx) + d <= tolerance) return Landing::Supported;
+	return std::hypot(d, double(target.dist_to_not_free.at<float>(cy, cx))) > tolerance ? Landing::Conflicting
+																						: Landing::Agreeing;
 }
 }  // namespace
 
@@ -153,6 +166,7 @@ OccupancyField occupancyField(const cv::Mat& classes, MapKind kind)
 		const cv::Mat outside = classes == kUnknown;
 		cv::distanceTransform(outside, f.dist_to_not_free, cv::DIST_L2, cv::DIST_MASK_PRECISE);
 		f.known = (f.dist_to_occupied <= kPlanVouchesCells) | outside;
+		f.empty_beyond = true;
 	}
 	const cv::Mat occupied = classes == kOccupied;
 	f.wall_normal_deg = wallNormals(occupied);
@@ -182,7 +196,6 @@ Support tolerantSupport(
 	{
 		const Eigen::Vector2d q = a * p + t.t;
 		const int x = static_cast<int>(std::lround(q.x())), y = static_cast<int>(std::lround(q.y()));
-		if (x < 0 || y < 0 || x >= w || y >= h) continue;
 		const Landing l = landing(target, x, y, tolerance);
 		if (l == Landing::Supported)
 		{
@@ -320,7 +333,8 @@ ShiftField shiftField(
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
-		if (!(q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach)) continue;
+		const bool near_image = q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach;
+		if (!near_image && !target.empty_beyond) continue;
 		Tile& tile_of_q = tiles[{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))}];
 		tile_of_q.landed.emplace_back(int(std::lround(q.x())), int(std::lround(q.y())));
 		tile_of_q.sources.push_back(p);
@@ -349,8 +363,8 @@ ShiftField shiftField(
 		const size_t window_cells = size_t(window_w) * size_t(y1 - y0 + 1);
 		std::vector<int8_t> worth(window_cells, 0);
 		std::vector<uint8_t> judged_at(window_cells, 0);
-		for (int y = std::max(0, y0); y <= std::min(h - 1, y1); ++y)
-			for (int x = std::max(0, x0); x <= std::min(w - 1, x1); ++x)
+		for (int y = y0; y <= y1; ++y)
+			for (int x = x0; x <= x1; ++x)
 			{
 				const Landing l = landing(target, x, y, tolerance);
 				const size_t i = size_t(y - y0) * window_w + size_t(x - x0);

@@ -115,6 +115,7 @@ PreparedMapPtr mirroredMap(const PreparedMap& map)
 	cv::flip(map.field.dist_to_occupied, p->field.dist_to_occupied, 1);
 	cv::flip(map.field.dist_to_not_free, p->field.dist_to_not_free, 1);
 	cv::flip(map.field.known, p->field.known, 1);
+	p->field.empty_beyond = map.field.empty_beyond;
 	p->features = features.get();
 	return p;
 }

@@ -59,10 +59,11 @@ void expectMergedRight(const std::string& ref, const std::string& other)
 	EXPECT_GE(res.confidence, 0.5);
 }
 
-void expectRefused(const std::string& ref, const std::string& other)
+void expectRefused(
+	const std::string& ref, const std::string& other, const CScalingGridMapAligner& aligner = CScalingGridMapAligner())
 {
 	SCOPED_TRACE(ref + " <- " + other);
-	const auto res = CScalingGridMapAligner().alignScaled(
+	const auto res = aligner.alignScaled(
 		loadGridMap(halmstad()->yaml(ref, dir())), loadGridMap(halmstad()->yaml(other, dir())));
 	EXPECT_FALSE(res.success) << "confidence " << res.confidence;
 	EXPECT_FALSE(res.message.empty());
@@ -300,6 +301,20 @@ TEST(RealMaps, HalmstadRobotMapsPlacedOnTheFloorPlan)
 	expectMergedRight("E5_07", "E5_layout");
 	expectRefused("KPT4A_layout", "E5_14");
 	expectRefused("F5_layout", "E5_07");
+}
+
+// Prepared as their known parts, plans lose the grey around their building:
+// what lies beyond the image is still the plan's outside. Without that, a
+// map of another building hanging off a plan's corner was judged only where
+// it touched the building, and merged.
+TEST(RealMaps, HalmstadFloorPlanCroppedToItsBuildingStillRefusesAnotherBuilding)
+{
+	REQUIRE_HALMSTAD();
+	CScalingGridMapAligner cropping;
+	cropping.options.crop_to_known = true;
+	expectRefused("F5_layout", "E5_09", cropping);
+	expectRefused("F5_layout", "E5_02", cropping);
+	expectRefused("KPT4A_layout", "E5_11", cropping);
 }
 
 TEST(RealMaps, HalmstadMirroredMapIsRefused)

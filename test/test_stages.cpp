@@ -260,6 +260,36 @@ TEST(MapAgreement, AFloorPlanJudgesNearItsWallsAndItsOutsideNotItsRooms)
 	EXPECT_EQ(furniture.judged, 0u) << "the plan's white far from its walls is drawn, not seen";
 	EXPECT_EQ(outside.judged, 1u);
 	EXPECT_EQ(outside.conflicts, 1u) << "a wall where the plan has no building conflicts";
+	// A plan draws its whole building: beyond its image is outside too.
+	const Support beyond = judge(-30, 50), far_beyond = judge(500, -400);
+	EXPECT_EQ(beyond.judged, 1u);
+	EXPECT_EQ(beyond.conflicts, 1u) << "a wall beyond the plan's image, where it has no building";
+	EXPECT_EQ(far_beyond.conflicts, 1u);
+	const OccupancyField robot = occupancyField(plan);
+	EXPECT_EQ(tolerantSupport({Eigen::Vector2d(-30, 50)}, robot, Similarity2D(), robot, 3.0, false).judged, 0u)
+		<< "a robot's map has seen nothing beyond its grid";
+}
+
+TEST(MapAgreement, APlanCroppedToItsBuildingJudgesAsAWiderOne)
+{
+	// The same plan twice: with 20 cells of outside around its building,
+	// and cropped to the building's walls. Points on, beside and beyond its
+	// walls are judged alike in both (the cropped one shifted by 20).
+	cv::Mat wide(100, 100, CV_8U, cv::Scalar(kUnknown));
+	wide(cv::Rect(20, 20, 60, 60)).setTo(kOccupied);
+	wide(cv::Rect(21, 21, 58, 58)).setTo(kFree);
+	const cv::Mat tight = wide(cv::Rect(20, 20, 60, 60)).clone();
+	const OccupancyField fw = occupancyField(wide, MapKind::FloorPlan), ft = occupancyField(tight, MapKind::FloorPlan);
+	for (const Eigen::Vector2d& p : {Eigen::Vector2d(20, 50), Eigen::Vector2d(18, 50), Eigen::Vector2d(16, 50),
+									Eigen::Vector2d(10, 50), Eigen::Vector2d(5, 5), Eigen::Vector2d(95, 60),
+									Eigen::Vector2d(82, 82)})
+	{
+		const Support sw = tolerantSupport({p}, fw, Similarity2D(), fw, 3.0, false);
+		const Support st = tolerantSupport({p}, ft, Similarity2D(1, 0, {-20, -20}), ft, 3.0, false);
+		EXPECT_EQ(sw.judged, st.judged) << p.transpose();
+		EXPECT_EQ(sw.supported, st.supported) << p.transpose();
+		EXPECT_EQ(sw.conflicts, st.conflicts) << p.transpose();
+	}
 }
 
 TEST(MapAgreement, WallsRunAlikeAtTruthNotWhenTurned)

@@ -48,6 +48,10 @@ struct OccupancyField
 	/** CV_8U: the wall normal (degrees, 0–179) at each occupied cell,
 	 * kNoDirection elsewhere. */
 	cv::Mat wall_normal_deg;
+	/** A floor plan draws its whole building, so beyond its image is its
+	 * outside, empty, judged like the outside it draws; a robot's map has
+	 * seen nothing beyond its grid. */
+	bool empty_beyond = false;
 };
 constexpr uint8_t kNoDirection = 255;
 
@@ -62,7 +66,7 @@ constexpr double kPlanVouchesCells = 3.0;
  * saw. A floor plan's field: inside the building only the space within
  * kPlanVouchesCells of its walls is known, so furniture on its white judges
  * nothing; what it leaves outside the building counts as seen empty, so a
- * wall there conflicts. */
+ * wall there conflicts, within its image or beyond (empty_beyond). */
 OccupancyField occupancyField(const cv::Mat& classes, MapKind kind = MapKind::Sensed);
 
 /** `known` grown by `cells` (rounded up, at least one) each way: the walls at
