@@ -32,17 +32,9 @@ namespace
  * own), unknown around it; the same map frame. */
 GridInFrame paddedTo(const GridInFrame& map, int side)
 {
-	const auto& g = map.grid;
-	const int w = int(g.getSizeX()), h = int(g.getSizeY());
+	const int w = int(map.grid.getSizeX()), h = int(map.grid.getSizeY());
 	const int left = std::max(0, side - w) / 2, below = std::max(0, side - h) / 2;
-	const double r = g.getResolution();
-	GridInFrame out;
-	out.kind = map.kind;
-	out.grid.setSize(0, float(std::max(side, w) * r), 0, float(std::max(side, h) * r), float(r), 0.5f);
-	for (int cy = 0; cy < h; ++cy) std::copy(g.getRow(cy), g.getRow(cy) + w, out.grid.getRow(cy + below) + left);
-	// Cell (left, below) of the padded grid is cell (0, 0) of the file's.
-	out.origin = map.origin.compose(Similarity2D(1, 0, {g.getXMin() - left * r, g.getYMin() - below * r}));
-	return out;
+	return widened(map, {left, below, std::max(0, side - w) - left, std::max(0, side - h) - below});
 }
 }  // namespace
 

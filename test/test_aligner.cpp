@@ -2,6 +2,7 @@
 #include <multires_map_merge/CScalingGridMapAligner.h>
 #include <multires_map_merge/EdgePoints.h>
 #include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/GroundTruthPair.h>
 
 #include <gtest/gtest.h>
@@ -13,7 +14,6 @@
 #include <map>
 #include <thread>
 
-#include "grid_padding.h"
 #include "test_data.h"
 
 using namespace multires_map_merge;
@@ -211,7 +211,9 @@ TEST(PreparedMaps, CroppedToTheKnownPartPaddingChangesNothing)
 	const auto pair = makePair(scansOf(test::mrptDataset(kMalaga)), Case{kMalaga, 0.05, 0.08, 30, 0.6});
 	CScalingGridMapAligner aligner;
 	aligner.options.crop_to_known = true;
-	const auto ref_padded = test::padded(pair.ref, 300, 40, 120), other_padded = test::padded(pair.other, 7, 210, 0);
+	const GridInFrame ref_w = widened(GridInFrame{pair.ref, Similarity2D(), MapKind::Sensed}, {300, 40, 120, 120}),
+					  other_w = widened(GridInFrame{pair.other, Similarity2D(), MapKind::Sensed}, {7, 210, 0, 0});
+	const auto &ref_padded = ref_w.grid, &other_padded = other_w.grid;
 	ASSERT_EQ(ref_padded.getSizeX(), pair.ref.getSizeX() + 420);
 	const auto ref = aligner.prepare(pair.ref), ref_p = aligner.prepare(ref_padded);
 	const auto other = aligner.prepare(pair.other), other_p = aligner.prepare(other_padded);
@@ -227,8 +229,10 @@ TEST(PreparedMaps, CroppedToTheKnownPartPaddingChangesNothing)
 	EXPECT_EQ(r_p.confidence, r.confidence);
 	EXPECT_EQ(r_p.cells.scale, r.cells.scale);
 	EXPECT_EQ(r_p.cells.yaw, r.cells.yaw);
-	EXPECT_LT((r_p.metric.t - r.metric.t).norm(), 1e-5);  // metres: MRPT keeps grid corners in float
-	EXPECT_NEAR(r_p.metric.yaw, r.metric.yaw, 1e-12);
+	// In metres, between the maps' frames (the padded grids' corners moved).
+	const Similarity2D metric_p = betweenMapFrames(ref_w, r_p.metric, other_w);
+	EXPECT_LT((metric_p.t - r.metric.t).norm(), 1e-5);  // MRPT keeps grid corners in float
+	EXPECT_NEAR(metric_p.yaw, r.metric.yaw, 1e-12);
 	// In the padded grids' cells: the same placement, shifted by the padding.
 	const Similarity2D shift_ref(1, 0, {300, 40}), shift_other(1, 0, {7, 210});
 	EXPECT_LT((r_p.cells.t - shift_ref.compose(r.cells).compose(shift_other.inverse()).t).norm(), 1e-6);

@@ -6,6 +6,7 @@
 #include <multires_map_merge/FleetGraph.h>
 #include <multires_map_merge/FleetMerge.h>
 #include <multires_map_merge/GridImage.h>
+#include <multires_map_merge/GridInFrame.h>
 #include <multires_map_merge/GroundTruthPair.h>
 #include <multires_map_merge/JointPlacement.h>
 #include <multires_map_merge/MapIO.h>
@@ -23,7 +24,6 @@
 #include <memory>
 
 #include "cli_run.h"
-#include "grid_padding.h"
 #include "test_data.h"
 
 using namespace multires_map_merge;
@@ -171,7 +171,7 @@ TEST(Fleet, CroppedToTheirKnownPartsPaddedMapsArePlacedAsTheyAre)
 	const Fleet& f = *fleet();
 	std::vector<GridInFrame> padded_maps = f.maps;
 	for (size_t m = 0; m < padded_maps.size(); ++m)
-		padded_maps[m].grid = test::padded(f.maps[m].grid, 150 + 40 * int(m), 90, 60);
+		padded_maps[m] = widened(f.maps[m], {150 + 40 * int(m), 90, 60, 60});
 	CScalingGridMapAligner cropping;
 	cropping.options.crop_to_known = true;
 	const FleetResult r = placeFleet(f.maps, 0, cropping), r_padded = placeFleet(padded_maps, 0, cropping);

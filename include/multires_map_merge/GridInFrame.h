@@ -39,6 +39,18 @@ struct GridInFrame
 	bool originIsIdentity() const { return origin.yaw == 0 && origin.t.isZero() && origin.scale == 1; }
 };
 
+/** Cells added on each side of a grid (x left and right, y below and above). */
+struct CellMargins
+{
+	int left = 0, below = 0, right = 0, above = 0;
+};
+
+/** The map with `m` more unknown cells around it, its map frame unchanged:
+ * how a map file holds padding around what the robot saw (gmapping saves
+ * its whole default grid). The new grid's corner is at its frame's (0, 0),
+ * as a map_server file's; the origin takes the shift, exactly. */
+GridInFrame widened(const GridInFrame& map, const CellMargins& m);
+
 /** Re-expresses a transform between two grids' metric frames as one between
  * their maps' frames: ref.origin ∘ between_grids ∘ other.origin⁻¹. */
 Similarity2D betweenMapFrames(
