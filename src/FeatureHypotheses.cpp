@@ -23,7 +23,8 @@ std::vector<LevelFeatures> extractPyramidFeatures(const cv::Mat& classes, const 
 {
 	auto sift = cv::SIFT::create(0, 3, p.sift_contrast_threshold, p.sift_edge_threshold);
 	std::vector<LevelFeatures> levels;
-	// The level's size against max_level_cells, and its side against min_level_size.
+	// What max_level_cells bounds (the cell count, or the longer side
+	// squared) and what min_level_size bounds (the shorter side, or the longer).
 	const double cells = p.levels_by_longer_side ? std::pow(std::max(classes.cols, classes.rows), 2.0)
 												 : double(classes.cols) * classes.rows;
 	const double side = p.levels_by_longer_side ? std::max(classes.cols, classes.rows)

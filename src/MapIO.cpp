@@ -378,12 +378,17 @@ std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, dou
 	if (unexpected) std::rethrow_exception(unexpected);
 	if (problems.size() > 1)
 	{
-		std::string all = std::to_string(problems.size()) + " maps cannot be read: ";
-		for (size_t i = 0; i < problems.size(); ++i) all += (i ? "; " : "") + problems[i];
-		throw MapIOError(all);
+		throw MapIOError(everyMapsProblem(problems, "cannot be read"));
 	}
 	if (first) std::rethrow_exception(first);
 	return maps;
+}
+
+std::string everyMapsProblem(const std::vector<std::string>& problems, const std::string& what)
+{
+	std::string all = std::to_string(problems.size()) + " maps " + what + ": ";
+	for (size_t i = 0; i < problems.size(); ++i) all += (i ? "; " : "") + problems[i];
+	return all;
 }
 
 std::string saveGridMap(const GridInFrame& map, const std::string& path)

@@ -47,6 +47,10 @@ std::string saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::
 
 bool hasSuffix(const std::string& s, const std::string& suffix);
 
+/** Several maps' problems in one message, each named as found:
+ * "N maps <what>: first; second; ...". */
+std::string everyMapsProblem(const std::vector<std::string>& problems, const std::string& what);
+
 /** Why a file cannot be written at `path` ("" when it can): no folder to
  * write into, a folder or other non-file in the way, or no permission.
  * Nothing is created or truncated; programs ask before any work, so that

@@ -1,4 +1,6 @@
 #include <multires_map_merge/ros/MergeMapsService.h>
+
+#include <multires_map_merge/MapIO.h>
 #include <multires_map_merge/ros/OccupancyGridConversion.h>
 
 #include <chrono>
@@ -55,9 +57,7 @@ std::vector<GridInFrame> gridsFromMsgs(const std::vector<nav_msgs::OccupancyGrid
 	if (problems.size() == 1) throw InvalidGridMessage(problems.front());
 	if (problems.size() > 1)
 	{
-		std::string all = std::to_string(problems.size()) + " maps are not usable grids: ";
-		for (size_t i = 0; i < problems.size(); ++i) all += (i ? "; " : "") + problems[i];
-		throw InvalidGridMessage(all);
+		throw InvalidGridMessage(everyMapsProblem(problems, "are not usable grids"));
 	}
 	return maps;
 }
