@@ -30,8 +30,8 @@ const std::vector<AlignerParamField>& alignerParamFields()
 	static const std::vector<AlignerParamField> fields{
 		// Preparation (PreparedMap.h)
 		{"crop_to_known", &P::crop_to_known, 0, 1, no0,
-		 "Prepare each map as the box of its known cells, so unknown padding around it changes nothing (off "
-		 "until the decision is calibrated on it)"},
+		 "Prepare each map as the box of its known cells, so unknown padding around it changes nothing (for "
+		 "heavily padded files; off: a little more recall on tightly saved ones)"},
 		// Features and RANSAC (FeatureHypotheses.h)
 		{"pyramid_levels", &P::pyramid_levels, 1, 8, no0, "Resolution levels per map (each halves the cells per axis)"},
 		{"feature_max_level_cells", &P::feature_max_level_cells, 4096, 1e10, no0,

@@ -27,8 +27,10 @@ struct AlignerParams : public mrpt::config::CLoadableOptions
 	 * framed in unknown (FeatureParams). How much unknown a file holds
 	 * around what a robot saw then changes nothing, neither the result nor
 	 * the time: a gmapping grid is 4000 cells across whatever it mapped.
-	 * Results stay in the grids' cells. Off by default until the decision
-	 * is calibrated on its candidates (docs/method.md, step 0). */
+	 * Results stay in the grids' cells. The decision is calibrated on its
+	 * candidates too; off by default because on files saved with little
+	 * padding the whole grid's search merges a few more pairs
+	 * (docs/method.md, step 0; docs/limits.md). */
 	bool crop_to_known = false;
 
 	// --- Features and RANSAC (initial hypotheses)
