@@ -315,6 +315,9 @@ ShiftScores scoreShifts(
 }
 }  // namespace
 
+/** Cells: beyond this, a point is not binned in a tile. */
+constexpr double kFarthestBinned = 1e8;
+
 ShiftField shiftField(
 	const PointList& points, const OccupancyField& source, const Similarity2D& t, const OccupancyField& target,
 	double tolerance, double tile, double reach, double step)
@@ -333,8 +336,11 @@ ShiftField shiftField(
 	for (const auto& p : points)
 	{
 		const Eigen::Vector2d q = a * p + t.t;
+		// Beyond a plan's image points are judged too, unless so far (a wild
+		// transform) that their tile's index would not fit in an int.
 		const bool near_image = q.x() > -reach && q.y() > -reach && q.x() < w + reach && q.y() < h + reach;
-		if (!near_image && !target.empty_beyond) continue;
+		const bool binnable = std::abs(q.x()) < kFarthestBinned && std::abs(q.y()) < kFarthestBinned;
+		if (!near_image && !(target.empty_beyond && binnable)) continue;
 		Tile& tile_of_q = tiles[{int(std::floor(q.x() / tile)), int(std::floor(q.y() / tile))}];
 		tile_of_q.landed.emplace_back(int(std::lround(q.x())), int(std::lround(q.y())));
 		tile_of_q.sources.push_back(p);

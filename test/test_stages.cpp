@@ -268,6 +268,15 @@ TEST(MapAgreement, AFloorPlanJudgesNearItsWallsAndItsOutsideNotItsRooms)
 	const OccupancyField robot = occupancyField(plan);
 	EXPECT_EQ(tolerantSupport({Eigen::Vector2d(-30, 50)}, robot, Similarity2D(), robot, 3.0, false).judged, 0u)
 		<< "a robot's map has seen nothing beyond its grid";
+	// Its tiles' shifts (the bent consistency) judge beyond it too; a wild
+	// transform's points, too far to bin, are dropped, not a crash.
+	PointList wall;
+	for (int y = 30; y < 70; ++y) wall.emplace_back(10, y);
+	const ShiftField bent = shiftField(wall, f, Similarity2D(), f, 3.0, 20, 4, 1);
+	EXPECT_EQ(bent.bent.judged, wall.size());
+	EXPECT_EQ(bent.bent.conflicts, wall.size());
+	const ShiftField wild = shiftField(wall, f, Similarity2D(1, 0, {1e15, -1e15}), f, 3.0, 20, 4, 1);
+	EXPECT_EQ(wild.bent.judged, 0u);
 }
 
 TEST(MapAgreement, APlanCroppedToItsBuildingJudgesAsAWiderOne)
