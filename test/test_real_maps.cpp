@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -301,6 +302,40 @@ TEST(RealMaps, HalmstadRobotMapsPlacedOnTheFloorPlan)
 	expectMergedRight("E5_07", "E5_layout");
 	expectRefused("KPT4A_layout", "E5_14");
 	expectRefused("F5_layout", "E5_07");
+}
+
+// A user's plan file is often cropped close to its building: saved so (the
+// origin moved to the crop's corner), the plan places a robot map where the
+// filed plan, grey all around, does; the truth judges both.
+TEST(RealMaps, HalmstadFloorPlanFileCroppedToItsBuildingPlacesARobotMapAsFiled)
+{
+	REQUIRE_HALMSTAD();
+	const cv::Mat plan = cv::imread(halmstad()->png("E5_layout"), cv::IMREAD_GRAYSCALE);
+	ASSERT_FALSE(plan.empty());
+	// map_server's trinary rule (thresholds 0.196 / 0.65): grey 90..204 is unknown.
+	const cv::Rect building = cv::boundingRect((plan < 90) | (plan > 204));
+	ASSERT_LT(building.area(), plan.rows * plan.cols / 2) << "the filed plan has grey around its building";
+	const std::string tight = dir() + "/E5_layout_tight";
+	ASSERT_TRUE(cv::imwrite(tight + ".pgm", plan(building)));
+	const double res = 0.05;  // the corner of the crop's bottom-left cell in the filed plan's frame
+	std::ofstream(tight + ".yaml") << "image: E5_layout_tight.pgm\nresolution: " << res << "\norigin: ["
+								   << building.x * res << ", " << (plan.rows - building.y - building.height) * res
+								   << ", 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nfloor_plan: true\n";
+
+	const GridInFrame filed = loadGridMap(halmstad()->yaml("E5_layout", dir())), cropped = loadGridMap(tight + ".yaml");
+	const GridInFrame robot = loadGridMap(halmstad()->yaml("E5_09", dir()));
+	ASSERT_EQ(cropped.kind, MapKind::FloorPlan);
+	const auto on_filed = CScalingGridMapAligner().alignScaled(filed, robot);
+	const auto on_cropped = CScalingGridMapAligner().alignScaled(cropped, robot);
+	ASSERT_TRUE(on_filed.success) << on_filed.message;
+	ASSERT_TRUE(on_cropped.success) << on_cropped.message;
+	const auto* truth = halmstad()->pair("E5_09", "E5_layout");
+	ASSERT_NE(truth, nullptr);
+	const int rows = static_cast<int>(filed.grid.getSizeY());  // both results are in the filed plan's frame
+	EXPECT_LE(multires_bench::judge(on_cropped.metric, *truth, robot, rows).mean_displacement_px, 40);
+	EXPECT_LT((on_cropped.metric.t - on_filed.metric.t).norm(), 0.25);  // metres: 5 px of the plan
+	EXPECT_NEAR(on_cropped.metric.yaw, on_filed.metric.yaw, 0.01);
+	EXPECT_NEAR(on_cropped.metric.scale / on_filed.metric.scale, 1.0, 0.01);
 }
 
 // Prepared as their known parts, plans lose the grey around their building:
