@@ -6,13 +6,14 @@
 // cell size is not stated (about 5 cm for the Intel lab): 5 cm. The
 // benchmark's section (carpin_maps.h) and test_real_maps read them so.
 
+#include "map_file.h"
+
 #include <multires_map_merge/Similarity2D.h>
 
 #include <mrpt/io/zip.h>
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -72,8 +73,7 @@ inline std::string writeAsMapServer(
 {
 	const std::string pgm = dir + "/" + name + ".pgm", yaml = dir + "/" + name + ".yaml";
 	if (!cv::imwrite(pgm, readGrid(txt_gz))) throw std::runtime_error("cannot write '" + pgm + "'");
-	std::ofstream(yaml) << "image: " << name << ".pgm\nresolution: " << resolution
-						<< "\norigin: [0.0, 0.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	multires_bench::writeMapServerYaml(yaml, name + ".pgm", resolution);
 	return yaml;
 }
 

@@ -1,5 +1,7 @@
 #include "halmstad.h"
 
+#include "map_file.h"
+
 #include <multires_map_merge/GridImage.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
@@ -161,9 +163,7 @@ std::string HalmstadData::yaml(const std::string& map, const std::string& dir) c
 	fs::create_directories(dir);
 	const std::string path = dir + "/" + map + ".yaml";
 	// Written each time: what it says is the benchmark's, not a stale file's.
-	std::ofstream(path) << "image: " << fs::absolute(png(map)).string() << "\nresolution: " << kHalmstadResolution
-						<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
-						<< (isSensorMap(map) ? "" : "floor_plan: true\n");
+	writeMapServerYaml(path, fs::absolute(png(map)).string(), kHalmstadResolution, 0, 0, !isSensorMap(map));
 	return path;
 }
 
@@ -194,8 +194,7 @@ std::string coarserYaml(const HalmstadData& data, const std::string& map, double
 	fs::create_directories(dir);
 	const std::string pgm = dir + "/" + name.str() + ".pgm";
 	if (!cv::imwrite(pgm, coarse)) throw std::runtime_error("'" + pgm + "': cannot write");
-	std::ofstream(yaml) << "image: " << fs::path(pgm).filename().string() << "\nresolution: " << kHalmstadResolution
-						<< "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	writeMapServerYaml(yaml, fs::path(pgm).filename().string(), kHalmstadResolution);
 	return yaml;
 }
 

@@ -1,5 +1,7 @@
 #include "partial_maps.h"
 
+#include "map_file.h"
+
 #include <multires_map_merge/MapIO.h>
 
 #include <mrpt/system/CTicTac.h>
@@ -7,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -79,13 +80,7 @@ MapHalf writeHalf(const HalmstadData& data, const std::string& map, size_t k, co
 	out.whole_rows = img.rows;
 	fs::create_directories(dir);
 	const std::string name = halfName(map, k);
-	const std::string pgm = dir + "/" + name + ".pgm";
-	out.yaml = dir + "/" + name + ".yaml";
-	if (!cv::imwrite(pgm, img(half).clone())) throw std::runtime_error("'" + pgm + "': cannot write");
-	const double r = kHalmstadResolution;
-	std::ofstream(out.yaml) << "image: " << fs::path(pgm).filename().string() << "\nresolution: " << r << "\norigin: ["
-							<< half.x * r << ", " << (img.rows - half.y - half.height) * r
-							<< ", 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	out.yaml = writeImagePart(img, half, kHalmstadResolution, dir + "/" + name);
 	return out;
 }
 

@@ -14,11 +14,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include <filesystem>
-#include <fstream>
 #include <memory>
 
 #include "../bench/carpin_data.h"
 #include "../bench/halmstad.h"
+#include "../bench/map_file.h"
 #include "../bench/partial_maps.h"
 #include "test_data.h"
 
@@ -312,17 +312,13 @@ TEST(RealMaps, HalmstadFloorPlanFileCroppedToItsBuildingPlacesARobotMapAsFiled)
 	REQUIRE_HALMSTAD();
 	const cv::Mat plan = cv::imread(halmstad()->png("E5_layout"), cv::IMREAD_GRAYSCALE);
 	ASSERT_FALSE(plan.empty());
-	// map_server's trinary rule (thresholds 0.196 / 0.65): grey 90..204 is unknown.
-	const cv::Rect building = cv::boundingRect((plan < 90) | (plan > 204));
+	const GridInFrame filed = loadGridMap(halmstad()->yaml("E5_layout", dir()));
+	// The building as map_server's rule reads the file (grey is unknown), in the image's rows.
+	const cv::Rect building = cv::boundingRect(forDisplay(toClassImage(filed.grid)) != kUnknown);
+	ASSERT_EQ(plan.size(), forDisplay(toClassImage(filed.grid)).size());
 	ASSERT_LT(building.area(), plan.rows * plan.cols / 2) << "the filed plan has grey around its building";
-	const std::string tight = dir() + "/E5_layout_tight";
-	ASSERT_TRUE(cv::imwrite(tight + ".pgm", plan(building)));
-	const double res = 0.05;  // the corner of the crop's bottom-left cell in the filed plan's frame
-	std::ofstream(tight + ".yaml") << "image: E5_layout_tight.pgm\nresolution: " << res << "\norigin: ["
-								   << building.x * res << ", " << (plan.rows - building.y - building.height) * res
-								   << ", 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\nfloor_plan: true\n";
-
-	const GridInFrame filed = loadGridMap(halmstad()->yaml("E5_layout", dir())), cropped = loadGridMap(tight + ".yaml");
+	const GridInFrame cropped = loadGridMap(
+		multires_bench::writeImagePart(plan, building, multires_bench::kHalmstadResolution, dir() + "/E5_layout_tight", true));
 	const GridInFrame robot = loadGridMap(halmstad()->yaml("E5_09", dir()));
 	ASSERT_EQ(cropped.kind, MapKind::FloorPlan);
 	const auto on_filed = CScalingGridMapAligner().alignScaled(filed, robot);
@@ -362,9 +358,7 @@ TEST(RealMaps, HalmstadMirroredMapIsRefused)
 	cv::Mat flipped;
 	cv::flip(img, flipped, 1);
 	cv::imwrite(dir() + "/" + map + "_mirrored.png", flipped);
-	std::ofstream(dir() + "/" + map + "_mirrored.yaml")
-		<< "image: " << map << "_mirrored.png\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
-		   "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	multires_bench::writeMapServerYaml(dir() + "/" + map + "_mirrored.yaml", map + "_mirrored.png", 0.05);
 	const GridInFrame mirrored = loadGridMap(dir() + "/" + map + "_mirrored.yaml");
 	const auto res = CScalingGridMapAligner().alignScaled(loadGridMap(halmstad()->yaml("E5_02", dir())), mirrored);
 	EXPECT_FALSE(res.success) << "confidence " << res.confidence;
@@ -488,8 +482,7 @@ TEST(RealMaps, TurtleBotMapsOfTwoDaysMergeWhateverTheirStatedResolution)
 	MMM_REQUIRE_SHARED(ref_yaml, "ros_maps/robotis_turtlebot3_lds_test_area/tb3_map_2017-02-07.yaml");
 	MMM_REQUIRE_SHARED(other_pgm, "ros_maps/robotis_turtlebot3_lds_test_area/tb3_map_2016-12-02.pgm");
 	const std::string yaml = dir() + "/tb3_2016-12-02_stated_10cm.yaml";
-	std::ofstream(yaml) << "image: " << other_pgm << "\nresolution: 0.1\norigin: [-10, -10, 0]\nnegate: 0\n"
-						<< "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	multires_bench::writeMapServerYaml(yaml, other_pgm, 0.1, -10, -10);
 	const auto r = CScalingGridMapAligner().alignScaled(loadGridMap(ref_yaml), loadGridMap(yaml));
 	ASSERT_TRUE(r.success) << r.message;
 	EXPECT_NEAR(wrapToPi(r.metric.yaw - 182.5 * M_PI / 180) * 180 / M_PI, 0, 1.5);
@@ -591,8 +584,7 @@ TEST(RealMaps, FaintGreyWallsAreReadAsWalls)
 	grey_walls.setTo(150, grey_walls < 180);
 	const std::string pgm = dir() + "/grey_walls.pgm", yaml = dir() + "/grey_walls.yaml";
 	ASSERT_TRUE(cv::imwrite(pgm, grey_walls));
-	std::ofstream(yaml) << "image: grey_walls.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
-						<< "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+	multires_bench::writeMapServerYaml(yaml, "grey_walls.pgm", 0.05);
 	EXPECT_EQ(cv::countNonZero(grey_walls < 89), 0) << "map_server would read no wall at all";
 
 	const GridInFrame faint = loadGridMap(yaml), original = loadGridMap(ref_yaml);
