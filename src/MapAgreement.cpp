@@ -369,8 +369,11 @@ ShiftField shiftField(
 		const size_t window_cells = size_t(window_w) * size_t(y1 - y0 + 1);
 		std::vector<int8_t> worth(window_cells, 0);
 		std::vector<uint8_t> judged_at(window_cells, 0);
-		for (int y = y0; y <= y1; ++y)
-			for (int x = x0; x <= x1; ++x)
+		// Off a robot map's grid nothing is judged (the zeros above); off a
+		// plan's image its outside is.
+		const bool whole_window = target.empty_beyond;
+		for (int y = whole_window ? y0 : std::max(y0, 0); y <= (whole_window ? y1 : std::min(y1, h - 1)); ++y)
+			for (int x = whole_window ? x0 : std::max(x0, 0); x <= (whole_window ? x1 : std::min(x1, w - 1)); ++x)
 			{
 				const Landing l = landing(target, x, y, tolerance);
 				const size_t i = size_t(y - y0) * window_w + size_t(x - x0);
