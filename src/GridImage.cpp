@@ -26,9 +26,14 @@ cv::Mat resampleMask(const cv::Mat& mask, double factor)
 	CV_Assert(mask.type() == CV_8UC1 && factor > 0);
 	const cv::Size size(std::max(1, cvRound(mask.cols * factor)), std::max(1, cvRound(mask.rows * factor)));
 	// INTER_AREA gives each output cell the fraction of set input cells under
-	// it; "any" is that fraction being non-zero.
-	cv::Mat frac;
-	cv::resize(mask, frac, size, 0, 0, factor < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
+	// it; "any" is that fraction being non-zero. In 8 bits one set cell of N
+	// under an output cell is 255/N, rounded to 0 past N = 510: where an
+	// output cell covers more than 255 input cells, the fractions are taken
+	// in floats (below, the 8-bit result is the same and cheaper).
+	const bool lone_cells_round_away = factor < 1 && 1.0 / (factor * factor) > 255;
+	cv::Mat source = mask, frac;
+	if (lone_cells_round_away) cv::Mat(mask != 0).convertTo(source, CV_32F);
+	cv::resize(source, frac, size, 0, 0, factor < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
 	return frac > 0;
 }
 
