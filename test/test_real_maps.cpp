@@ -143,13 +143,13 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 	// The pair is decided on its best-scoring candidate, by its lead over the
 	// best candidate that puts the other map elsewhere: the decision value
 	// and the reported rival must be exactly those of the candidate list.
-	// E5_14 <- E5_13 merges, E5_12 <- E5_01 does not (calibration data);
+	// E5_11 <- E5_02 merges, E5_12 <- E5_01 does not (calibration data);
 	// both best scores are below the threshold, so their rivals are refined
 	// (a score alone reaching it merges whatever comes).
 	const CScalingGridMapAligner aligner;
 	const auto& o = aligner.options;
 	ASSERT_GT(o.decision.runner_up_weight, 0);
-	for (const auto& [ref, other] : {std::pair{"E5_14", "E5_13"}, std::pair{"E5_12", "E5_01"}})
+	for (const auto& [ref, other] : {std::pair{"E5_11", "E5_02"}, std::pair{"E5_12", "E5_01"}})
 	{
 		SCOPED_TRACE(std::string(ref) + " <- " + other);
 		const auto res = aligner.alignScaled(
@@ -188,10 +188,10 @@ TEST(RealMaps, HalmstadDecisionWeighsTheBestDistinctRival)
 TEST(RealMaps, HalmstadPairMergesWhicheverMapIsNamedFirst)
 {
 	REQUIRE_HALMSTAD();
-	// E5_01 <- E5_12 merges; E5_12 <- E5_01 is refused as searched (the
+	// E5_02 <- E5_11 merges; E5_11 <- E5_02 is refused as searched (the
 	// search is not symmetric in the maps), and with both_orders merges
 	// with the roles swapped back: the same alignment, inverted.
-	const GridInFrame a = loadGridMap(halmstad()->yaml("E5_12", dir())), b = loadGridMap(halmstad()->yaml("E5_01", dir()));
+	const GridInFrame a = loadGridMap(halmstad()->yaml("E5_11", dir())), b = loadGridMap(halmstad()->yaml("E5_02", dir()));
 	CScalingGridMapAligner aligner;
 	EXPECT_FALSE(aligner.options.both_orders) << "the default";
 	const auto one_way = aligner.alignScaled(a, b);
@@ -206,7 +206,7 @@ TEST(RealMaps, HalmstadPairMergesWhicheverMapIsNamedFirst)
 	EXPECT_NEAR(round_trip.t.norm(), 0, 1e-6);
 	EXPECT_NEAR(round_trip.scale, 1, 1e-9);
 	EXPECT_NEAR(named_first.implied_resolution_other * other_way.implied_resolution_other, 0.05 * 0.05, 1e-9);
-	const auto truth = halmstad()->pair("E5_01", "E5_12");
+	const auto truth = halmstad()->pair("E5_02", "E5_11");
 	ASSERT_NE(truth, nullptr);
 	EXPECT_TRUE(multires_bench::judge(named_first.metric, *truth, b, static_cast<int>(a.grid.getSizeY())).right);
 }

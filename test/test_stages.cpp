@@ -46,21 +46,6 @@ TEST(GridImage, ResamplingKeepsThinWallsAndFreeSpace)
 	}
 }
 
-TEST(GridImage, ResamplingFarCoarserKeepsALoneWallCell)
-{
-	// A long corridor map brought to the structure search's working size:
-	// each output cell covers ~1100 input cells, where an 8-bit average of
-	// one set cell rounds to nothing.
-	cv::Mat mask(300, 9000, CV_8UC1, cv::Scalar(0));
-	mask.at<uint8_t>(150, 4500) = 255;
-	const double factor = 256.0 / 9000;
-	const cv::Mat coarse = resampleMask(mask, factor);
-	EXPECT_EQ(cv::countNonZero(coarse), 1);
-	cv::Mat classes(mask.size(), CV_8UC1, cv::Scalar(kFree));
-	classes.setTo(kOccupied, mask);
-	EXPECT_EQ(cv::countNonZero(resampleClasses(classes, factor) == kOccupied), 1);
-}
-
 TEST(EdgePoints, OnlyOccupiedCellsTouchingFreeSpace)
 {
 	cv::Mat img(5, 6, CV_8UC1, cv::Scalar(kUnknown));

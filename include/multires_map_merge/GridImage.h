@@ -49,7 +49,9 @@ cv::Mat toClassImage(const mrpt::maps::COccupancyGridMap2D& grid);
 Similarity2D cellToMetric(const mrpt::maps::COccupancyGridMap2D& grid);
 
 /** Resamples a mask (0 / non-zero) by `factor` (< 1 shrinks): an output
- * cell is set (255) if any input cell under it is. */
+ * cell is set (255) if any input cell under it is, or where it covers more
+ * than 510 input cells, if at least one in 510 of them is (a lone cell
+ * drops out). */
 cv::Mat resampleMask(const cv::Mat& mask, double factor);
 
 /** Resamples a class image by `factor` (< 1 shrinks) the way a coarser grid
