@@ -1,5 +1,7 @@
 #include "map_file.h"
 
+#include <multires_map_merge/MapIO.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
@@ -12,11 +14,10 @@ void writeMapServerYaml(
 	const std::string& yaml, const std::string& image, double resolution, double corner_x, double corner_y,
 	bool floor_plan)
 {
+	using multires_map_merge::MapKind;
 	std::ofstream out(yaml);
-	out.precision(10);  // cells × resolution, without a product's last-bit noise
-	out << "image: " << image << "\nresolution: " << resolution << "\norigin: [" << corner_x << ", " << corner_y
-		<< ", 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
-		<< (floor_plan ? "floor_plan: true\n" : "");
+	out << multires_map_merge::mapServerYaml(
+		image, resolution, {corner_x, corner_y}, 0, floor_plan ? MapKind::FloorPlan : MapKind::Sensed);
 	if (!out) throw std::runtime_error("'" + yaml + "': cannot write");
 }
 

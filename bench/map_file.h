@@ -1,7 +1,7 @@
 #pragma once
-// map_server files as the benchmark and the tests write them: one place for
-// the yaml's fields (map_server's default thresholds, the floor-plan flag
-// MapIO reads) and for saving part of an image where it lies in the whole.
+// map_server files as the benchmark and the tests write them from images
+// (the yaml's text is MapIO's mapServerYaml), and part of an image saved
+// where it lies in the whole.
 #include <opencv2/core.hpp>
 
 #include <string>

@@ -372,8 +372,10 @@ ShiftField shiftField(
 		// Off a robot map's grid nothing is judged (the zeros above); off a
 		// plan's image its outside is.
 		const bool whole_window = target.empty_beyond;
-		for (int y = whole_window ? y0 : std::max(y0, 0); y <= (whole_window ? y1 : std::min(y1, h - 1)); ++y)
-			for (int x = whole_window ? x0 : std::max(x0, 0); x <= (whole_window ? x1 : std::min(x1, w - 1)); ++x)
+		const int judged_x0 = whole_window ? x0 : std::max(x0, 0), judged_x1 = whole_window ? x1 : std::min(x1, w - 1);
+		const int judged_y0 = whole_window ? y0 : std::max(y0, 0), judged_y1 = whole_window ? y1 : std::min(y1, h - 1);
+		for (int y = judged_y0; y <= judged_y1; ++y)
+			for (int x = judged_x0; x <= judged_x1; ++x)
 			{
 				const Landing l = landing(target, x, y, tolerance);
 				const size_t i = size_t(y - y0) * window_w + size_t(x - x0);

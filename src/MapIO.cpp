@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -437,17 +438,33 @@ std::string saveGridMap(const GridInFrame& map, const std::string& path)
 		img.setTo(205, img == kUnknown);
 		// map_server images have +y up: the first row is the top of the map.
 		if (!cv::imwrite(pgm.string(), forDisplay(img))) fail(pgm.string(), "cannot write");
-		const Eigen::Vector2d corner = map.cornerInMapFrame();
 		std::ofstream y(path);
-		y.precision(17);  // the origin round-trips exactly
-		y << "image: " << pgm.filename().string() << "\n"
-		  << "resolution: " << grid.getResolution() << "\n"
-		  << "origin: [" << corner.x() << ", " << corner.y() << ", " << map.origin.yaw << "]\n"
-		  << "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n";
+		y << mapServerYaml(
+			pgm.filename().string(), grid.getResolution(), map.cornerInMapFrame(), map.origin.yaw, map.kind);
 		if (!y) fail(path, "cannot write");
 		return "";
 	}
 	fail(path, "unknown output format (expected .gridmap[.gz] or .yaml)");
+}
+
+namespace
+{
+/** The shortest decimal that reads back as `v` exactly. */
+std::string exactDecimal(double v)
+{
+	std::array<char, 32> text{};
+	const auto end = std::to_chars(text.data(), text.data() + text.size(), v).ptr;
+	return std::string(text.data(), end);
+}
+}  // namespace
+
+std::string mapServerYaml(
+	const std::string& image, double resolution, const Eigen::Vector2d& corner, double yaw, MapKind kind)
+{
+	return "image: " + image + "\nresolution: " + exactDecimal(resolution) + "\norigin: [" + exactDecimal(corner.x()) +
+		   ", " + exactDecimal(corner.y()) + ", " + exactDecimal(yaw) +
+		   "]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n" +
+		   (kind == MapKind::FloorPlan ? "floor_plan: true\n" : "");
 }
 
 std::string saveGridMap(const COccupancyGridMap2D& grid, const std::string& path)

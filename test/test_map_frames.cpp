@@ -148,6 +148,12 @@ TEST(MapFrames, YamlOriginRoundTripsExactly)
 	EXPECT_NEAR(back.origin.yaw, map.origin.yaw, 1e-15);
 	EXPECT_EQ(back.grid.getSizeX(), map.grid.getSizeX());
 	EXPECT_EQ(cv::countNonZero(toClassImage(back.grid) != toClassImage(map.grid)), 0);
+	EXPECT_EQ(back.kind, MapKind::Sensed);
+	// A floor plan saved as a .yaml reloads as a plan.
+	map.kind = MapKind::FloorPlan;
+	saveGridMap(map, tmp("plan.yaml"));
+	EXPECT_EQ(loadGridMap(tmp("plan.yaml")).kind, MapKind::FloorPlan);
+	map.kind = MapKind::Sensed;
 	// A .gridmap cannot hold a rotation, and says how far it moves an
 	// off-lattice corner.
 	EXPECT_THROW(saveGridMap(map, tmp("origin.gridmap.gz")), MapIOError);

@@ -314,8 +314,9 @@ TEST(RealMaps, HalmstadFloorPlanFileCroppedToItsBuildingPlacesARobotMapAsFiled)
 	ASSERT_FALSE(plan.empty());
 	const GridInFrame filed = loadGridMap(halmstad()->yaml("E5_layout", dir()));
 	// The building as map_server's rule reads the file (grey is unknown), in the image's rows.
-	const cv::Rect building = cv::boundingRect(forDisplay(toClassImage(filed.grid)) != kUnknown);
-	ASSERT_EQ(plan.size(), forDisplay(toClassImage(filed.grid)).size());
+	const cv::Mat classes = forDisplay(toClassImage(filed.grid));
+	const cv::Rect building = cv::boundingRect(classes != kUnknown);
+	ASSERT_EQ(plan.size(), classes.size());
 	ASSERT_LT(building.area(), plan.rows * plan.cols / 2) << "the filed plan has grey around its building";
 	const GridInFrame cropped = loadGridMap(
 		multires_bench::writeImagePart(plan, building, multires_bench::kHalmstadResolution, dir() + "/E5_layout_tight", true));

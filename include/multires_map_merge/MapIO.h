@@ -40,10 +40,20 @@ std::vector<GridInFrame> loadGridMaps(const std::vector<std::string>& paths, dou
  * (0, 0) in the map's frame, with its yaw). A .yaml holds the origin exactly.
  * A .gridmap cannot hold a rotated origin (MapIOError) and snaps the corner to
  * a multiple of the cell size: the return value then says by how much the
- * written map is shifted ("" when the file holds the map exactly). */
+ * written map is shifted ("" when the file holds the map exactly). A floor
+ * plan's .yaml says `floor_plan: true`, so it reloads as a plan. */
 std::string saveGridMap(const GridInFrame& map, const std::string& path);
 /** A grid whose own metric frame is the map's frame. */
 std::string saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
+
+/** The text of a map_server yaml for `image` (named as the yaml names it:
+ * relative to the yaml, or absolute): `resolution` m per cell, the image's
+ * bottom-left corner at `corner` in the map's frame, turned by `yaw`;
+ * trinary, map_server's default thresholds; a floor plan adds
+ * `floor_plan: true` (map_server ignores it). Numbers are written in the
+ * shortest form that reads back exactly. */
+std::string mapServerYaml(
+	const std::string& image, double resolution, const Eigen::Vector2d& corner, double yaw, MapKind kind);
 
 bool hasSuffix(const std::string& s, const std::string& suffix);
 
