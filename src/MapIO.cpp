@@ -450,21 +450,35 @@ std::string saveGridMap(const GridInFrame& map, const std::string& path)
 namespace
 {
 /** The shortest decimal that reads back as `v` exactly. */
-std::string exactDecimal(double v)
+template <typename Number>
+std::string exactDecimal(Number v)
 {
 	std::array<char, 32> text{};
 	const auto end = std::to_chars(text.data(), text.data() + text.size(), v).ptr;
 	return std::string(text.data(), end);
+}
+
+/** `s` as a YAML double-quoted scalar: a file name may hold '#' or ": ",
+ * which a plain scalar would end at. */
+std::string quotedYaml(const std::string& s)
+{
+	YAML::Emitter e;
+	e << YAML::DoubleQuoted << s;
+	return e.c_str();
 }
 }  // namespace
 
 std::string mapServerYaml(
 	const std::string& image, double resolution, const Eigen::Vector2d& corner, double yaw, MapKind kind)
 {
-	return "image: " + image + "\nresolution: " + exactDecimal(resolution) + "\norigin: [" + exactDecimal(corner.x()) +
-		   ", " + exactDecimal(corner.y()) + ", " + exactDecimal(yaw) +
-		   "]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n" +
-		   (kind == MapKind::FloorPlan ? "floor_plan: true\n" : "");
+	// A grid's resolution is a float: written as that float's shortest
+	// decimal (0.05, not 0.05000000074505806), which a grid reads back as it.
+	const bool a_float = double(float(resolution)) == resolution;
+	return "image: " + quotedYaml(image) +
+		"\nresolution: " + (a_float ? exactDecimal(float(resolution)) : exactDecimal(resolution)) +
+		"\norigin: [" + exactDecimal(corner.x()) + ", " + exactDecimal(corner.y()) + ", " + exactDecimal(yaw) +
+		"]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n" +
+		(kind == MapKind::FloorPlan ? "floor_plan: true\n" : "");
 }
 
 std::string saveGridMap(const COccupancyGridMap2D& grid, const std::string& path)

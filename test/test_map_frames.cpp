@@ -149,10 +149,13 @@ TEST(MapFrames, YamlOriginRoundTripsExactly)
 	EXPECT_EQ(back.grid.getSizeX(), map.grid.getSizeX());
 	EXPECT_EQ(cv::countNonZero(toClassImage(back.grid) != toClassImage(map.grid)), 0);
 	EXPECT_EQ(back.kind, MapKind::Sensed);
-	// A floor plan saved as a .yaml reloads as a plan.
+	// A floor plan saved as a .yaml reloads as a plan, under a name that
+	// YAML would cut at '#' or ": " unless quoted.
 	map.kind = MapKind::FloorPlan;
-	saveGridMap(map, tmp("plan.yaml"));
-	EXPECT_EQ(loadGridMap(tmp("plan.yaml")).kind, MapKind::FloorPlan);
+	saveGridMap(map, tmp("plan #1: v2.yaml"));
+	const GridInFrame plan = loadGridMap(tmp("plan #1: v2.yaml"));
+	EXPECT_EQ(plan.kind, MapKind::FloorPlan);
+	EXPECT_EQ(cv::countNonZero(toClassImage(plan.grid) != toClassImage(map.grid)), 0);
 	map.kind = MapKind::Sensed;
 	// A .gridmap cannot hold a rotation, and says how far it moves an
 	// off-lattice corner.

@@ -50,8 +50,9 @@ std::string saveGridMap(const mrpt::maps::COccupancyGridMap2D& grid, const std::
  * relative to the yaml, or absolute): `resolution` m per cell, the image's
  * bottom-left corner at `corner` in the map's frame, turned by `yaw`;
  * trinary, map_server's default thresholds; a floor plan adds
- * `floor_plan: true` (map_server ignores it). Numbers are written in the
- * shortest form that reads back exactly. */
+ * `floor_plan: true` (map_server ignores it). The image's name is quoted
+ * (it may hold '#' or ": "); numbers are written in the shortest form that
+ * reads back exactly (a resolution that is a float's, as that float). */
 std::string mapServerYaml(
 	const std::string& image, double resolution, const Eigen::Vector2d& corner, double yaw, MapKind kind);
 
