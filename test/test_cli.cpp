@@ -170,8 +170,9 @@ TEST(Cli, BadInputAndUsageExitTwoNamingTheProblem)
 	EXPECT_FALSE(fs::exists(d + "/x.png"));
 }
 
-// An output that cannot be written stops the run before any map is loaded
-// or aligned (REF is not even announced), naming the option and the file.
+// An output that cannot be written, or an output resolution that cannot be
+// read, stops the run before any map is loaded or aligned (REF is not even
+// announced), naming the option and the file.
 TEST(Cli, UnwritableOutputsExitTwoBeforeAnyWork)
 {
 	const std::string d = dir();
@@ -188,6 +189,7 @@ TEST(Cli, UnwritableOutputsExitTwoBeforeAnyWork)
 			 Bad{maps + " --json " + d + "/a_folder", "--json '" + d + "/a_folder': exists and is not a file"},
 			 Bad{maps + " --out " + d + "/a_folder.yaml --json " + d + "/r.json --png " + d + "/a_folder",
 				 "--png '" + d + "/a_folder': exists"},
+			 Bad{maps + " --out " + d + "/m.yaml --output-resolution 0", "--output-resolution must be"},
 		 })
 	{
 		SCOPED_TRACE(b.args);

@@ -242,6 +242,7 @@ void checkRequest(const Request& q)
 		throw UsageError("'" + q.config + "': no such config file");
 	if (!std::isfinite(q.simplemap_resolution) || !(q.simplemap_resolution > 0))
 		throw UsageError("--simplemap-resolution must be metres > 0");
+	outputResolution(q.output_resolution, 1, 1);  // throws on a spec it cannot read
 	if (!q.out.empty() && !hasSuffix(q.out, ".gridmap.gz") && !hasSuffix(q.out, ".gridmap") && !hasSuffix(q.out, ".yaml"))
 		throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
 	for (const auto& [option, path] : {std::pair<std::string, std::string>{"json", q.json}, {"out", q.out}, {"png", q.png}})
