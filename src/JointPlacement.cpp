@@ -59,8 +59,7 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		for (size_t i = 0; i < used.size(); ++i)
 		{
 			const FleetEdge& e = edges[used[i]];
-			const double w =
-				std::sqrt(weight[i]) / (coarseCellInReference(maps, placements, e) * tolerance_cells[used[i]]);
+			const double w = std::sqrt(weight[i]) / coarseCellInReference(maps, placements, e);
 			for (int c = 0; c < 4; ++c)
 			{
 				// T_from(p) − T_to(M(p)) = 0 at the points p of the pair's
@@ -89,9 +88,9 @@ std::vector<std::optional<Similarity2D>> refineJointly(
 		// of its tolerance.
 		for (size_t i = 0; i < used.size(); ++i)
 		{
-			// The rows hold sqrt(weight) / (cell × tolerance) × each point's two coordinates.
+			// The rows hold sqrt(weight) / cell × each point's two coordinates: r is the RMS in tolerances.
 			const double r = (a.middleRows(int(i) * 8, 8) * x - y.segment<8>(int(i) * 8)).norm() /
-				(2 * std::sqrt(weight[i]));
+				(2 * std::sqrt(weight[i]) * tolerance_cells[used[i]]);
 			weight[i] = r <= params.robust_share ? 1.0 : params.robust_share / r;
 		}
 	}

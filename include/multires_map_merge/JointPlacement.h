@@ -28,9 +28,13 @@ struct JointPlacementParams
  * placed map; the reference fixed) refined from every confident pair that is
  * not dropped and joins two placed maps, each weighed where it measured
  * (FleetEdge::overlap; without one, at its `from` map's walls: `spread`,
- * one WallSpread per map) in units of its tolerance
- * (`tolerance_cells`, one per edge, cells of its coarser map: FleetParams::
- * toleranceOf), so a precise pair counts more than one of bent maps. A map
+ * one WallSpread per map) in cells of its coarser map, every pair alike:
+ * an edge RMSE between independent runs says how much the two maps differ
+ * (clutter, doors, wall thickness), not how precisely the pair places them
+ * (weighed by it, a pair of two look-alike maps outvoted a direct pair to
+ * the reference). Its tolerance (`tolerance_cells`, one per edge, cells of
+ * its coarser map: FleetParams::toleranceOf) sets how far it may disagree
+ * with the others before it counts less (JointPlacementParams). A map
  * whose refined pose moves its walls from its tree placement by more than
  * its `max_move_cells` (one per map; the cycle check admits pairs that far
  * apart around the cycles it lies on), or than the largest tolerance of its
