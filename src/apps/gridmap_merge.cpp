@@ -52,6 +52,11 @@ double outputResolution(const std::string& spec, double ref_res, double other_re
 	throw UsageError("--output-resolution must be 'reference', 'finest' or metres > 0, not '" + spec + "'");
 }
 
+/** Throws UsageError on a --output-resolution that outputResolution cannot
+ * read: checked before any map is loaded, so a typo is not found only after
+ * a merge. */
+void checkOutputResolution(const std::string& spec) { outputResolution(spec, 1.0, 1.0); }
+
 /** The maps, each a grid in its exact frame (a map_server origin, a ROS
  * message's info.origin; identity for .gridmap files), and their names. */
 struct Inputs
@@ -242,7 +247,7 @@ void checkRequest(const Request& q)
 		throw UsageError("'" + q.config + "': no such config file");
 	if (!std::isfinite(q.simplemap_resolution) || !(q.simplemap_resolution > 0))
 		throw UsageError("--simplemap-resolution must be metres > 0");
-	outputResolution(q.output_resolution, 1, 1);  // throws on a spec it cannot read
+	checkOutputResolution(q.output_resolution);
 	if (!q.out.empty() && !hasSuffix(q.out, ".gridmap.gz") && !hasSuffix(q.out, ".gridmap") && !hasSuffix(q.out, ".yaml"))
 		throw UsageError("--out must end in .gridmap.gz, .gridmap or .yaml");
 	for (const auto& [option, path] : {std::pair<std::string, std::string>{"json", q.json}, {"out", q.out}, {"png", q.png}})
