@@ -79,7 +79,7 @@ cv::Mat MapWalls::at(double f) const
 		if (auto it = walls_.find(f); it != walls_.end()) return it->second;
 	}
 	// Made outside the lock (the threads would wait on each other); the first one made kept.
-	cv::Mat made = wallImage(classes_ == kOccupied, f);
+	cv::Mat made = wallImage(occupied_, f);
 	std::lock_guard<std::mutex> lock(mutex_);
 	return walls_.emplace(f, std::move(made)).first->second;
 }

@@ -9,6 +9,7 @@
 // Used only when no feature hypothesis is confident (it costs more).
 
 #include <multires_map_merge/FeatureHypotheses.h>
+#include <multires_map_merge/GridImage.h>
 
 #include <opencv2/core.hpp>
 
@@ -36,7 +37,7 @@ struct StructureParams
 class MapWalls
 {
    public:
-	explicit MapWalls(cv::Mat classes) : classes_(std::move(classes)) {}
+	explicit MapWalls(cv::Mat classes) : classes_(std::move(classes)), occupied_(classes_ == kOccupied) {}
 	const cv::Mat& classes() const { return classes_; }
 	/** dominantWallDirection of the classes. */
 	double dominantDirection() const;
@@ -47,6 +48,7 @@ class MapWalls
 
    private:
 	cv::Mat classes_;
+	cv::Mat occupied_;  // every size's walls start from it
 	mutable std::once_flag direction_once_;
 	mutable double direction_ = 0;
 	mutable std::mutex mutex_;
